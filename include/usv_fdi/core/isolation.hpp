@@ -1,0 +1,190 @@
+// Detection and isolation (the isolation thread's engine), DESIGN.md sections 3 and 4.
+//
+// Two dedicated observers on the current estimate of A give the structured residual
+//   s = [ (y1 - x1^V) / sigma_sa , (y2 - x2^G) / sigma_sg ]
+// whose first entry is blind to gyro faults and second to accelerometer faults, so a fault
+// of sensor i keeps s on l_i (l_a = [1 0]^T, l_g = [0 1]^T). Isolation confidence
+//   C_i = |l_i^T e| / (||l_i|| ||e||)
+// on the windowed excess-energy vector e of s. The cross residuals
+//   d = [ (y1 - x1^G) / sigma_da , (y2 - x2^V) / sigma_dg ]
+// see a fault of sensor i without absorption (observer G never sees y1), so they hold a
+// raised fault while it persists. Sensor-level checks (after PX4's data validator) catch
+// stale, stuck, invalid and spiky channels.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "usv_fdi/core/identification.hpp"
+#include "usv_fdi/core/observer.hpp"
+#include "usv_fdi/core/types.hpp"
+
+namespace usvfdi {
+
+struct IsolationParams {
+  Vec2 poles_v = Vec2(-0.5, -0.7);  ///< poles of observer V [1/s]
+  Vec2 poles_g = Vec2(-0.5, -0.7);  ///< poles of observer G [1/s]
+  double min_observability = 1e-3;  ///< refuse an observer design below this index
+  double redesign_tolerance = 0.005;  ///< relative change of A that triggers a redesign
+  double sigma_v = 0.0;     ///< accelerometer-channel noise [m/s]; 0: learn online
+  double sigma_r = 0.0;     ///< gyro noise [rad/s]; 0: learn online
+  double sigma_floor_v = 1e-4;  ///< floor of every v-channel scale [m/s]
+  double sigma_floor_r = 1e-5;  ///< floor of every r-channel scale [rad/s]
+  double settle_time = -1;  ///< observer settling after arming [s]; <0: 3 / min|pole|
+  double learn_time = 30.0;  ///< healthy data used to learn scales and threshold [s]
+  double window = 0.5;       ///< evaluation window J_N [s]
+  int min_window_samples = 10;  ///< the window holds at least this many samples
+  double clip = 4.0;         ///< whitened residuals are clipped to +-clip inside J_N
+  double threshold = 4.0;    ///< minimum enter threshold on J_N (whitened mean square)
+  double threshold_k = 8.0;  ///< learned threshold: mean + k std of healthy J_N
+  double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
+  double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]
+  double leave_time = 1.0;   ///< below the leave threshold this long clears [s]
+  double c_min = 0.8;        ///< isolation needs C_i >= c_min ...
+  double c_margin = 0.3;     ///< ... and C_i - C_other >= c_margin; else sensor unknown
+  double resume_time = 2.0;  ///< quiet time before identification resumes [s]
+  // Sensor-level checks.
+  double stale_timeout = 0.5;  ///< no valid value for this long: stale [s]
+  double stuck_time = 0.5;     ///< value unchanged for this long: stuck [s]
+  int stuck_min_samples = 5;   ///< ... and for at least this many samples
+  double max_abs_v = 20.0;     ///< |v| above this is invalid [m/s]
+  double max_abs_r = 3.0;      ///< |r| above this is invalid [rad/s]
+  double max_abs_delta = 1.6;  ///< |delta| above this is invalid [rad]
+  double spike_gate = 8.0;     ///< |s_i| above this on 1-2 samples is a spike
+  double spike_window = 3.0;   ///< spikes are counted over this window [s]
+  int spike_count = 3;         ///< this many spikes in the window raise a spikes fault
+  int invalid_count = 3;       ///< this many invalid values in spike_window raise invalid
+  double classify_window = 4.0;  ///< history used to name the kind of a fault [s]
+
+  /// Throws std::invalid_argument naming the offending field.
+  void validate() const;
+};
+
+/// A change of the fault condition of one sensor (the latch turns it into events).
+struct Detection {
+  Sensor sensor = Sensor::kUnknown;
+  bool active = false;  ///< true: condition raised; false: condition cleared
+  FaultKind kind = FaultKind::kUnknown;
+  double c_a = 0.0, c_g = 0.0;
+  double statistic = 0.0, threshold = 0.0;
+  double onset_time = kNaN;      ///< estimated onset [s, source clock]
+  double detection_time = kNaN;  ///< sample time of the decision [s]
+  std::string message;
+};
+
+/// Reason flags for the inputs (FdiStatus).
+struct InputHealth {
+  bool v_ok = true, r_ok = true, delta_ok = true;
+  std::uint64_t rejected_time = 0;     ///< samples whose time did not increase
+  std::uint64_t invalid_values = 0;    ///< NaN/Inf/absurd values seen
+  std::uint64_t gaps = 0;              ///< gaps longer than stale_timeout
+};
+
+struct IsolatorStatus {
+  bool armed = false;
+  bool learning = false;
+  bool settling = false;
+  std::string observer_problem;  ///< why an observer design was refused (empty when fine)
+  Mat2 A_design = Mat2::Zero();
+  Vec2 k_v = Vec2::Zero(), k_g = Vec2::Zero();
+  Vec2 sigma_s = Vec2::Zero();  ///< scales of the structured residual [m/s, rad/s]
+  Vec2 sigma_d = Vec2::Zero();  ///< scales of the cross residual
+  double threshold = 0.0;       ///< enter threshold on J_N in force
+  Vec2 J = Vec2::Zero();        ///< windowed statistic per channel (structured)
+  Vec2 D = Vec2::Zero();        ///< windowed statistic per channel (cross)
+  double c_a = 0.0, c_g = 0.0;
+  InputHealth input;
+  std::uint64_t samples = 0;
+};
+
+class Isolator {
+ public:
+  /// Throws std::invalid_argument on bad parameters.
+  Isolator(const IsolationParams& params, const Vec2& B);
+
+  /// Installs the latest identification snapshot. Arms (designs the observers) the first
+  /// time the estimate has converged; afterwards redesigns when A moved enough.
+  void set_estimate(const Estimate& est);
+
+  /// Processes one sample; appends every change of a sensor's fault condition to out.
+  /// Returns false when the sample was rejected (time did not increase).
+  bool update(const Sample& s, std::vector<Detection>* out);
+
+  /// True while identification must not learn from the data (fault suspected or active,
+  /// inputs unusable, or within resume_time of that).
+  bool freeze_requested() const { return freeze_; }
+  const IsolatorStatus& status() const { return st_; }
+  const IsolationParams& params() const { return p_; }
+
+ private:
+  struct Window {
+    std::deque<double> v;
+    double sum = 0.0;
+    void push(double x, std::size_t n);
+    double mean() const { return v.empty() ? 0.0 : sum / static_cast<double>(v.size()); }
+  };
+  struct Condition {
+    bool active = false;
+    unsigned sources = 0;  ///< bitmask of Source
+    FaultKind kind = FaultKind::kUnknown;
+  };
+  enum Source : unsigned {
+    kResidual = 1u, kStale = 2u, kStuck = 4u, kSpikes = 8u, kInvalid = 16u
+  };
+  struct Channel {
+    double last_valid_t = kNaN;
+    double last_value = kNaN;
+    double stuck_since = kNaN;
+    int stuck_samples = 0;
+    std::deque<double> spikes;    ///< times of spikes
+    std::deque<double> invalids;  ///< times of invalid values
+    int outlier_run = 0;
+    double outlier_start = kNaN;
+  };
+
+  bool design(const Mat2& A);
+  void set_condition(Sensor sensor, Source src, bool on, FaultKind kind, double t,
+                     const std::string& message, std::vector<Detection>* out);
+  Detection make_detection(Sensor sensor, bool active, FaultKind kind, double t) const;
+  void sensor_checks(const Sample& s, std::vector<Detection>* out);
+  void residual_checks(const Sample& s, double dt, std::vector<Detection>* out);
+  FaultKind classify(int ch) const;
+  double onset_estimate(int ch, double t) const;
+  std::size_t window_samples(double dt) const;
+
+  IsolationParams p_;
+  Vec2 B_;
+  IsolatorStatus st_;
+  DedicatedObserver obs_v_, obs_g_;
+  bool have_prev_ = false;
+  Sample prev_{};
+  double t_armed_ = kNaN;
+  double settle_until_ = kNaN;
+  bool theory_scales_pending_ = false;
+  double settle_time_ = 0.0;
+  double t_last_suspect_ = -1e300;
+  bool freeze_ = false;
+  bool scales_configured_ = false;
+  bool scales_learned_ = false;
+  // learning accumulators (Welford) for s and d raw residuals, and J
+  std::array<double, 4> lw_mean_{}, lw_m2_{};
+  std::uint64_t lw_n_ = 0;
+  double lj_mean_ = 0, lj_m2_ = 0;
+  std::uint64_t lj_n_ = 0;
+  std::array<Window, 2> win_s_;   ///< clipped squared structured residuals
+  std::array<Window, 2> win_sl_;  ///< signed structured residuals (classification)
+  std::array<Window, 2> win_d_;   ///< clipped squared cross residuals
+  std::array<std::deque<std::pair<double, double>>, 2> hist_s_;  ///< (t, whitened structured)
+  std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
+  std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
+  std::array<Channel, 3> ch_;  ///< v, r, delta
+  std::array<Condition, 3> cond_;  ///< accelerometer, gyro, unknown
+  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown
+  std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
+  double last_delta_ = kNaN;
+};
+
+}  // namespace usvfdi

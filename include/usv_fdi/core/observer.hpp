@@ -1,0 +1,74 @@
+// Dedicated Luenberger observers of DESIGN.md section 3.
+//
+// Observer V is driven by the accelerometer channel alone (K = [k_V 0], needs a2 != 0),
+// observer G by the gyro alone (K = [0 k_G], needs a3 != 0). Gains by pole placement on
+// the current estimate of A. Discretised exactly for inputs held over a step (ZOH).
+#pragma once
+
+#include <string>
+
+#include "usv_fdi/core/types.hpp"
+
+namespace usvfdi {
+
+/// Result of a pole-placement design for the pair (A, e_c^T).
+struct ObserverDesign {
+  bool ok = false;
+  Vec2 k = Vec2::Zero();         ///< continuous gain: x' = (A - k e_c^T) x + B delta + k y_c
+  Mat2 F = Mat2::Zero();         ///< A - k e_c^T
+  double observability = 0.0;    ///< scale-free observability index (see place_poles)
+  std::string reason;            ///< why the design was refused (empty when ok)
+};
+
+/// Places the poles p1, p2 (real, negative) of A - k e_c^T, c = channel (kV or kR).
+/// The observability index is |a2| sigma_r/sigma_v (c = kV) or |a3| sigma_v/sigma_r (c = kR),
+/// i.e. the coupling in whitened coordinates, divided by sqrt(p1 p2). The design is refused
+/// when the index is below min_observability or a pole is not strictly negative.
+ObserverDesign place_poles(const Mat2& A, int channel, double p1, double p2, double sigma_v,
+                           double sigma_r, double min_observability);
+
+/// A single-output observer advanced exactly over each step.
+class DedicatedObserver {
+ public:
+  DedicatedObserver() = default;
+  /// Installs a design; the state is kept (bumpless).
+  void set_design(const ObserverDesign& d, const Vec2& B);
+  bool ready() const { return ready_; }
+  int channel() const { return channel_; }
+  void set_channel(int c) { channel_ = c; }
+
+  /// Predicted state x^(k|k-1).
+  const Vec2& x() const { return x_; }
+  void reset(const Vec2& x0) { x_ = x0; }
+
+  /// Discrete matrices for the last step length (valid after the first step).
+  const Mat2& Ad() const { return Ad_; }
+  const Vec2& Gy() const { return Gy_; }
+  const Vec2& k() const { return k_; }
+
+  /// Advances over dt with delta and the driving measurement y_c held (ZOH). Pass
+  /// use_measurement = false to run open loop for this step (invalid measurement).
+  void step(double dt, double delta, double y_c, bool use_measurement);
+
+ private:
+  void discretise(double dt);
+  int channel_ = kV;
+  bool ready_ = false;
+  Mat2 F_ = Mat2::Zero(), A_ = Mat2::Zero();
+  Vec2 k_ = Vec2::Zero(), B_ = Vec2::Zero();
+  double dt_ = -1.0;
+  Mat2 Ad_ = Mat2::Identity(), Ad_open_ = Mat2::Identity();
+  Vec2 Gd_ = Vec2::Zero(), Gy_ = Vec2::Zero(), Gd_open_ = Vec2::Zero();
+  Vec2 x_ = Vec2::Zero();
+};
+
+/// Exact ZOH discretisation of x' = M x + N u (2 states, up to 2 inputs): returns
+/// (exp(M h), integral_0^h exp(M s) ds N).
+void zoh_discretise(const Mat2& M, const Eigen::Matrix<double, 2, 2>& N, double h, Mat2* Md,
+                    Eigen::Matrix<double, 2, 2>* Nd);
+
+/// Stationary covariance of e+ = Ad e + g w, w ~ (0, 1): solves P = Ad P Ad^T + g g^T.
+/// Returns false when Ad is not Schur stable.
+bool discrete_lyapunov(const Mat2& Ad, const Vec2& g, Mat2* P);
+
+}  // namespace usvfdi
