@@ -63,6 +63,7 @@ void Identifier::restart_filters(const Sample& s) {
   fd1_ = fd2_ = 0.0;
   prev_ = s;
   have_prev_ = true;
+  have_prev2_ = false;
   restart_pending_ = false;
   t_start_ = s.t;
   est_.warming_up = true;
@@ -84,16 +85,27 @@ bool Identifier::update(const Sample& s, bool freeze) {
   }
   const double dt = s.t - prev_.t;
   const Vec2 y(s.v, s.r), y_prev(prev_.v, prev_.r);
+  // Curvature of each input over the step (zero until three samples are known).
+  Vec2 ydd = Vec2::Zero();
+  double ddd = 0.0;
+  if (p_.curvature_correction && have_prev2_) {
+    const double hp = prev_.t - prev2_.t;
+    ydd(0) = FohLowPass::curvature(prev2_.v, prev_.v, s.v, hp, dt);
+    ydd(1) = FohLowPass::curvature(prev2_.r, prev_.r, s.r, hp, dt);
+    ddd = FohLowPass::curvature(prev2_.delta, prev_.delta, s.delta, hp, dt);
+  }
   f1_.set_step(dt);
-  for (int i = 0; i < 2; ++i) q_(i) = f1_.step(y_prev(i), y(i), q_(i));
-  fd1_ = f1_.step(prev_.delta, s.delta, fd1_);
+  for (int i = 0; i < 2; ++i) q_(i) = f1_.step_curved(y_prev(i), y(i), ydd(i), q_(i));
+  fd1_ = f1_.step_curved(prev_.delta, s.delta, ddd, fd1_);
   m_ = p_.eps1 * (y - q_) - B_ * fd1_;
   if (p_.method == IdentMethod::kPaper) {
     f2_.set_step(dt);
-    for (int i = 0; i < 2; ++i) qb_(i) = f2_.step(y_prev(i), y(i), qb_(i));
-    fd2_ = f2_.step(prev_.delta, s.delta, fd2_);
+    for (int i = 0; i < 2; ++i) qb_(i) = f2_.step_curved(y_prev(i), y(i), ydd(i), qb_(i));
+    fd2_ = f2_.step_curved(prev_.delta, s.delta, ddd, fd2_);
     mb_ = p_.eps2 * (y - qb_) - B_ * fd2_;
   }
+  prev2_ = prev_;
+  have_prev2_ = true;
   prev_ = s;
   est_.warming_up = s.t - t_start_ < warmup_;
   if (est_.warming_up) return true;

@@ -35,6 +35,7 @@ struct IdentificationParams {
   double lambda = 0.05;     ///< Kreisselmeier forgetting rate [1/s]
   double warmup_time = -1;  ///< filter warm-up before regressions are used [s]; <0: 10/min(eps)
   double max_gap = 1.0;     ///< a time gap longer than this restarts the filters [s]
+  bool curvature_correction = true;  ///< filter the inputs' curvature too (O(h^3) error)
   Vec4 a0 = Vec4::Zero();   ///< initial estimate [a1 a2 a3 a4]
   // Convergence criterion (reported, and what arms the isolation thread).
   double min_excitation = 0.01;    ///< normalised excitation in [0,1] needed to converge
@@ -94,6 +95,8 @@ class Identifier {
   bool have_prev_ = false;
   bool restart_pending_ = true;
   Sample prev_{};
+  Sample prev2_{};        ///< the sample before prev_ (for the curvature)
+  bool have_prev2_ = false;
   double t_start_ = kNaN;  ///< time the filters (re)started
   // filter states: F1[y], F1[delta], F2[y], F2[delta]
   Vec2 q_ = Vec2::Zero(), m_ = Vec2::Zero();
