@@ -168,7 +168,8 @@ void Identifier::update_convergence(double t) {
   }
   est_.settling = d;
   const bool excited =
-      est_.excitation >= p_.min_excitation && est_.time_constant <= p_.settle_window;
+      est_.excitation >= p_.min_excitation &&
+      est_.time_constant <= p_.settle_window * p_.settle_windows;
   settled_count_ = (d < p_.settle_tolerance && excited) ? settled_count_ + 1 : 0;
   if (settled_count_ >= p_.settle_windows) est_.converged = true;
   t_ref_ = t;

@@ -24,6 +24,23 @@ void prune(std::deque<std::pair<double, double>>* q, double t_min) {
   while (!q->empty() && q->front().first < t_min) q->pop_front();
 }
 
+double median(std::vector<double>* v) {
+  if (v->empty()) return 0.0;
+  auto mid = v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2);
+  std::nth_element(v->begin(), mid, v->end());
+  return *mid;
+}
+
+/// 1.4826 * median absolute deviation: the standard deviation for Gaussian data, robust to
+/// outliers and to a fault covering less than half of the data.
+double robust_std(std::vector<double>* v) {
+  if (v->size() < 2) return 0.0;
+  const double m = median(v);
+  std::vector<double> dev(v->size());
+  for (std::size_t i = 0; i < v->size(); ++i) dev[i] = std::abs((*v)[i] - m);
+  return 1.4826 * median(&dev);
+}
+
 }  // namespace
 
 void IsolationParams::validate() const {
@@ -85,6 +102,7 @@ Isolator::Isolator(const IsolationParams& params, const Vec2& B) : p_(params), B
   obs_v_.set_channel(kV);
   obs_g_.set_channel(kR);
   scales_configured_ = p_.sigma_v > 0;
+  floor_s_ = floor_d_ = Vec2(p_.sigma_floor_v, p_.sigma_floor_r);
   const double pmin = std::min(p_.poles_v.cwiseAbs().minCoeff(), p_.poles_g.cwiseAbs().minCoeff());
   settle_time_ = p_.settle_time >= 0 ? p_.settle_time : 3.0 / pmin;
 }
@@ -298,10 +316,18 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       const double d = usable(prev_.delta, p_.max_abs_delta) ? prev_.delta
                        : std::isfinite(last_delta_)         ? last_delta_
                                                             : 0.0;
-      const bool pv = usable(prev_.v, p_.max_abs_v) && !(cond_[0].sources & kStuck);
-      const bool pr = usable(prev_.r, p_.max_abs_r) && !(cond_[1].sources & kStuck);
-      obs_v_.step(dt, d, pv ? prev_.v : 0.0, pv);
-      obs_g_.step(dt, d, pr ? prev_.r : 0.0, pr);
+      // While a sensor is faulty, its dedicated observer is driven by the other observer's
+      // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
+      // the fault stays fully visible and the residual is clean the moment the fault ends.
+      const bool fa = cond_[0].active, fg = cond_[1].active;
+      const bool pv = usable(prev_.v, p_.max_abs_v) && !fa;
+      const bool pr = usable(prev_.r, p_.max_abs_r) && !fg;
+      const double yv = pv ? prev_.v : obs_g_.x()(0);
+      const double yr = pr ? prev_.r : obs_v_.x()(1);
+      const bool use_v = pv || (fa && !fg);
+      const bool use_r = pr || (fg && !fa);
+      obs_v_.step(dt, d, yv, use_v);
+      obs_g_.step(dt, d, yr, use_r);
     }
   }
   st_.settling = s.t < settle_until_;
@@ -314,12 +340,9 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     const bool okg = discrete_lyapunov(obs_g_.Ad(), obs_g_.Gy(), &Pg);
     if (okv && okg) {
       const double sv2 = p_.sigma_v * p_.sigma_v, sr2 = p_.sigma_r * p_.sigma_r;
-      st_.sigma_s(0) = std::sqrt(sv2 + sv2 * Pv(0, 0));
-      st_.sigma_s(1) = std::sqrt(sr2 + sr2 * Pg(1, 1));
-      st_.sigma_d(0) = std::sqrt(sv2 + sr2 * Pg(0, 0));
-      st_.sigma_d(1) = std::sqrt(sr2 + sv2 * Pv(1, 1));
-      st_.threshold = p_.threshold;
-      scales_learned_ = true;
+      // Floors for the learned scales: what sensor noise alone would give.
+      floor_s_ = Vec2(std::sqrt(sv2 + sv2 * Pv(0, 0)), std::sqrt(sr2 + sr2 * Pg(1, 1)));
+      floor_d_ = Vec2(std::sqrt(sv2 + sr2 * Pg(0, 0)), std::sqrt(sr2 + sv2 * Pv(1, 1)));
     }
     theory_scales_pending_ = false;
   }
@@ -333,21 +356,16 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   if (!scales_learned_) {
     if (s.t - t_learn0 < 0.5 * p_.learn_time) {
       if (v_ok && r_ok) {
-        ++lw_n_;
-        for (int i = 0; i < 4; ++i) {
-          const double delta = raw[i] - lw_mean_[i];
-          lw_mean_[i] += delta / static_cast<double>(lw_n_);
-          lw_m2_[i] += delta * (raw[i] - lw_mean_[i]);
-        }
+        for (int i = 0; i < 4; ++i) learn_raw_[i].push_back(raw[i]);
       }
       return;
     }
     if (st_.sigma_s(0) == 0.0) {
-      const double n = static_cast<double>(std::max<std::uint64_t>(lw_n_, 2) - 1);
-      st_.sigma_s(0) = std::max(std::sqrt(lw_m2_[0] / n), p_.sigma_floor_v);
-      st_.sigma_s(1) = std::max(std::sqrt(lw_m2_[1] / n), p_.sigma_floor_r);
-      st_.sigma_d(0) = std::max(std::sqrt(lw_m2_[2] / n), p_.sigma_floor_v);
-      st_.sigma_d(1) = std::max(std::sqrt(lw_m2_[3] / n), p_.sigma_floor_r);
+      st_.sigma_s(0) = std::max(robust_std(&learn_raw_[0]), floor_s_(0));
+      st_.sigma_s(1) = std::max(robust_std(&learn_raw_[1]), floor_s_(1));
+      st_.sigma_d(0) = std::max(robust_std(&learn_raw_[2]), floor_d_(0));
+      st_.sigma_d(1) = std::max(robust_std(&learn_raw_[3]), floor_d_(1));
+      for (auto& v : learn_raw_) std::vector<double>().swap(v);
     }
   }
 
@@ -377,16 +395,16 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
 
   if (!scales_learned_) {
     if (win_s_[0].v.size() >= n && win_s_[1].v.size() >= n) {
-      for (int c = 0; c < 2; ++c) {
-        ++lj_n_;
-        const double delta = st_.J(c) - lj_mean_;
-        lj_mean_ += delta / static_cast<double>(lj_n_);
-        lj_m2_ += delta * (st_.J(c) - lj_mean_);
-      }
+      learn_J_.push_back(st_.J(0));
+      learn_J_.push_back(st_.J(1));
     }
     if (s.t - t_learn0 >= p_.learn_time) {
-      const double sd = lj_n_ > 1 ? std::sqrt(lj_m2_ / static_cast<double>(lj_n_ - 1)) : 0.0;
-      st_.threshold = std::max(p_.threshold, lj_mean_ + p_.threshold_k * sd);
+      const double med = median(&learn_J_);
+      const double sd = robust_std(&learn_J_);
+      // J_N of clipped residuals cannot exceed clip^2: keep the threshold reachable.
+      st_.threshold = std::min(std::max(p_.threshold, med + p_.threshold_k * sd),
+                               0.75 * p_.clip * p_.clip);
+      std::vector<double>().swap(learn_J_);
       scales_learned_ = true;
       st_.learning = false;
     }
@@ -397,12 +415,21 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   for (int c = 0; c < 2; ++c) {
     if (!std::isfinite(sw(c))) continue;
     Channel& ch = ch_[c];
-    if (std::abs(sw(c)) > p_.spike_gate) {
-      if (ch.outlier_run++ == 0) ch.outlier_start = s.t;
+    // A spike is a run of one or two outliers with ordinary samples on both sides.
+    const double a = std::abs(sw(c));
+    if (a > p_.spike_gate) {
+      if (ch.outlier_run++ == 0) {
+        ch.outlier_start = s.t;
+        ch.run_isolated = ch.last_ordinary;
+      }
     } else {
-      if (ch.outlier_run >= 1 && ch.outlier_run <= 2) ch.spikes.push_back(ch.outlier_start);
+      const bool ordinary = a < 0.5 * p_.spike_gate;
+      if (ch.outlier_run >= 1 && ch.outlier_run <= 2 && ch.run_isolated && ordinary) {
+        ch.spikes.push_back(ch.outlier_start);
+      }
       ch.outlier_run = 0;
     }
+    ch.last_ordinary = a < 0.5 * p_.spike_gate;
     prune(&ch.spikes, s.t - p_.spike_window);
     const int count = static_cast<int>(ch.spikes.size());
     const bool on = count >= p_.spike_count;

@@ -28,6 +28,8 @@ Simulator::Simulator(const SimConfig& cfg) : c_(cfg), rng_(cfg.seed) {
   sigma_[1] = c_.sigma_r >= 0 ? c_.sigma_r : c_.vessel.sigma_r;
   held_.assign(c_.faults.size(), std::numeric_limits<double>::quiet_NaN());
   target_ = c_.vessel.turn_angle;
+  if (c_.sine_amplitude < 0) c_.sine_amplitude = c_.vessel.sine_amplitude;
+  if (c_.sine_frequency < 0) c_.sine_frequency = c_.vessel.sine_frequency;
 }
 
 double Simulator::autopilot(double psi_ref) const {
@@ -151,6 +153,7 @@ SimConfig paper_scenario(const VesselModel& vessel, double rate_hz, std::uint64_
   c.rate_hz = rate_hz;
   c.duration = 100.0;
   c.seed = seed;
+  c.steering = Steering::kSine;  // the paper does not say; a smooth rudder sine, as in DESIGN.md
   const double sv = vessel.sigma_v, sr = vessel.sigma_r;
   c.faults.push_back({Sensor::kGyro, FaultKind::kBias, 20.0, 40.0, 10.0 * sr, 2.0});
   c.faults.push_back({Sensor::kAccelerometer, FaultKind::kBias, 60.0, 80.0, 10.0 * sv, 2.0});

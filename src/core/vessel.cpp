@@ -19,6 +19,8 @@ VesselModel make_mariner() {
   m.autopilot_bandwidth = 0.06;
   m.turn_angle = 20.0 * kDeg;
   m.turn_period = 120.0;
+  m.sine_amplitude = 10.0 * kDeg;
+  m.sine_frequency = 0.05;
   m.sigma_v = 5e-3;
   m.sigma_r = 5e-4;
   return m;
@@ -40,6 +42,8 @@ VesselModel make_otter() {
   m.autopilot_bandwidth = 0.6;
   m.turn_angle = 20.0 * kDeg;
   m.turn_period = 20.0;
+  m.sine_amplitude = 2.0 * kDeg;
+  m.sine_frequency = 0.4;
   m.sigma_v = 5e-3;
   m.sigma_r = 5e-4;
   return m;

@@ -39,7 +39,7 @@ struct IdentificationParams {
   Vec4 a0 = Vec4::Zero();   ///< initial estimate [a1 a2 a3 a4]
   // Convergence criterion (reported, and what arms the isolation thread).
   double min_excitation = 0.01;    ///< normalised excitation in [0,1] needed to converge
-  double settle_window = 2.0;      ///< length of one settling window [s]
+  double settle_window = 1.0;      ///< length of one settling window [s]
   double settle_tolerance = 0.01;  ///< max relative change of every a_n over one window
   int settle_windows = 3;          ///< consecutive settled windows needed
   double settle_floor = 1e-4;      ///< absolute floor of the relative change's denominator

@@ -29,17 +29,19 @@ struct IsolationParams {
   Vec2 poles_g = Vec2(-0.5, -0.7);  ///< poles of observer G [1/s]
   double min_observability = 1e-3;  ///< refuse an observer design below this index
   double redesign_tolerance = 0.005;  ///< relative change of A that triggers a redesign
-  double sigma_v = 0.0;     ///< accelerometer-channel noise [m/s]; 0: learn online
-  double sigma_r = 0.0;     ///< gyro noise [rad/s]; 0: learn online
+  /// Sensor noise. The residual scales are always learned on healthy data after arming
+  /// (they include model mismatch); configured sensor noise sets their floors.
+  double sigma_v = 0.0;     ///< accelerometer-channel noise [m/s]; 0: floors only
+  double sigma_r = 0.0;     ///< gyro noise [rad/s]; 0: floors only
   double sigma_floor_v = 1e-4;  ///< floor of every v-channel scale [m/s]
   double sigma_floor_r = 1e-5;  ///< floor of every r-channel scale [rad/s]
   double settle_time = -1;  ///< observer settling after arming [s]; <0: 3 / min|pole|
-  double learn_time = 30.0;  ///< healthy data used to learn scales and threshold [s]
+  double learn_time = 10.0;  ///< healthy data used to learn scales and threshold [s]
   double window = 0.5;       ///< evaluation window J_N [s]
   int min_window_samples = 10;  ///< the window holds at least this many samples
   double clip = 4.0;         ///< whitened residuals are clipped to +-clip inside J_N
-  double threshold = 4.0;    ///< minimum enter threshold on J_N (whitened mean square)
-  double threshold_k = 8.0;  ///< learned threshold: mean + k std of healthy J_N
+  double threshold = 6.0;    ///< minimum enter threshold on J_N (whitened mean square)
+  double threshold_k = 8.0;  ///< learned threshold: median + k robust std of healthy J_N
   double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
   double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]
   double leave_time = 1.0;   ///< below the leave threshold this long clears [s]
@@ -142,6 +144,8 @@ class Isolator {
     std::deque<double> spikes;    ///< times of spikes
     std::deque<double> invalids;  ///< times of invalid values
     int outlier_run = 0;
+    bool last_ordinary = true;  ///< the previous residual was well inside the gate
+    bool run_isolated = false;  ///< the current outlier run began after an ordinary sample
     double outlier_start = kNaN;
   };
 
@@ -169,11 +173,11 @@ class Isolator {
   bool freeze_ = false;
   bool scales_configured_ = false;
   bool scales_learned_ = false;
-  // learning accumulators (Welford) for s and d raw residuals, and J
-  std::array<double, 4> lw_mean_{}, lw_m2_{};
-  std::uint64_t lw_n_ = 0;
-  double lj_mean_ = 0, lj_m2_ = 0;
-  std::uint64_t lj_n_ = 0;
+  Vec2 floor_s_ = Vec2::Zero(), floor_d_ = Vec2::Zero();  ///< floors of the learned scales
+  // Learning samples (robust statistics: a fault during learning cannot inflate the scales
+  // unless it covers half of the learning time).
+  std::array<std::vector<double>, 4> learn_raw_;  ///< s_a, s_g, d_a, d_g raw residuals
+  std::vector<double> learn_J_;
   std::array<Window, 2> win_s_;   ///< clipped squared structured residuals
   std::array<Window, 2> win_sl_;  ///< signed structured residuals (classification)
   std::array<Window, 2> win_d_;   ///< clipped squared cross residuals

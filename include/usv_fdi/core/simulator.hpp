@@ -39,8 +39,8 @@ struct SimConfig {
   double sigma_delta = 0.0;  ///< rudder measurement noise [rad]
   double disturbance = 0.0;  ///< std of white process noise on v' and r' (waves) [unit/s/sqrt(s)]
   Steering steering = Steering::kAutopilot;
-  double sine_amplitude = 10.0 * M_PI / 180.0;  ///< [rad]
-  double sine_frequency = 0.2;                  ///< [rad/s]
+  double sine_amplitude = -1;  ///< [rad]; < 0: the vessel's
+  double sine_frequency = -1;  ///< [rad/s]; < 0: the vessel's
   int substeps = 10;  ///< RK4 steps per sample
   std::vector<FaultInjection> faults;
 };

@@ -20,6 +20,8 @@ struct VesselModel {
   double autopilot_bandwidth = 0.0;   ///< natural frequency of the heading loop [rad/s]
   double turn_angle = 0.0;       ///< heading change of the scripted course [rad]
   double turn_period = 0.0;      ///< time between course changes [s]
+  double sine_amplitude = 0.0;   ///< open-loop identification input amplitude [rad]
+  double sine_frequency = 0.0;   ///< open-loop identification input frequency [rad/s]
   double sigma_v = 0.0;          ///< realistic sway-velocity noise [m/s]
   double sigma_r = 0.0;          ///< realistic yaw-rate noise [rad/s]
 };

@@ -1,0 +1,184 @@
+#include "usv_fdi/dds/dds_context.hpp"
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/qos/PublisherQos.hpp>
+#include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/dds/topic/qos/TopicQos.hpp>
+#include <fastrtps/types/TypesBase.h>
+
+namespace usv_fdi::dds {
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+[[noreturn]] void fail(const std::string& what) {
+  throw std::runtime_error("usv_fdi::dds: " + what);
+}
+
+template <class PubSubType>
+void register_type(fdds::DomainParticipant& participant) {
+  fdds::TypeSupport type(new PubSubType());
+  const std::string name = type.get_type_name();
+  if (type.register_type(&participant) != ReturnCode_t::RETCODE_OK) {
+    fail("registering type '" + name + "' failed");
+  }
+}
+
+std::string type_name_of(TopicId id) {
+  switch (id) {
+    case TopicId::kIns:
+      return fdi::InsSamplePubSubType().getName();
+    case TopicId::kRudder:
+      return fdi::RudderSamplePubSubType().getName();
+    case TopicId::kFaultEvent:
+      return fdi::FaultEventPubSubType().getName();
+    case TopicId::kFaultAck:
+      return fdi::FaultAckPubSubType().getName();
+    case TopicId::kStatus:
+      return fdi::FdiStatusPubSubType().getName();
+  }
+  fail("invalid topic id");
+}
+
+std::size_t index_of(TopicId id) {
+  const auto i = static_cast<std::size_t>(id);
+  if (i >= kTopicCount) fail("invalid topic id " + std::to_string(i));
+  return i;
+}
+
+}  // namespace
+
+std::string_view to_string(TopicId id) noexcept {
+  switch (id) {
+    case TopicId::kIns:
+      return "ins";
+    case TopicId::kRudder:
+      return "rudder";
+    case TopicId::kFaultEvent:
+      return "fault_event";
+    case TopicId::kFaultAck:
+      return "fault_ack";
+    case TopicId::kStatus:
+      return "status";
+  }
+  return "invalid";
+}
+
+const std::string& TopicNames::operator[](TopicId id) const {
+  switch (id) {
+    case TopicId::kIns:
+      return ins;
+    case TopicId::kRudder:
+      return rudder;
+    case TopicId::kFaultEvent:
+      return fault_event;
+    case TopicId::kFaultAck:
+      return fault_ack;
+    case TopicId::kStatus:
+      return status;
+  }
+  fail("invalid topic id");
+}
+
+namespace detail {
+void throw_write_failed(const fdds::DataWriter& writer) {
+  const fdds::Topic* topic = writer.get_topic();
+  fail("write on topic '" + (topic != nullptr ? topic->get_name() : std::string("?")) + "' failed");
+}
+}  // namespace detail
+
+void DdsContext::ParticipantDeleter::operator()(fdds::DomainParticipant* participant) const noexcept {
+  if (participant == nullptr) return;
+  // Errors cannot be reported from a destructor; Fast DDS logs them.
+  (void)participant->delete_contained_entities();
+  (void)fdds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+}
+
+DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
+  if (config_.profiles_file.empty()) {
+    load_default_profiles();
+  } else {
+    load_profiles_file(config_.profiles_file);
+  }
+
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  participant_.reset(factory->create_participant_with_profile(
+      static_cast<fdds::DomainId_t>(config_.domain_id), config_.participant_profile));
+  if (!participant_) {
+    fail("creating participant on domain " + std::to_string(config_.domain_id) +
+         " from profile '" + config_.participant_profile + "' failed");
+  }
+
+  register_type<fdi::InsSamplePubSubType>(*participant_);
+  register_type<fdi::RudderSamplePubSubType>(*participant_);
+  register_type<fdi::FaultEventPubSubType>(*participant_);
+  register_type<fdi::FaultAckPubSubType>(*participant_);
+  register_type<fdi::FdiStatusPubSubType>(*participant_);
+
+  for (std::size_t i = 0; i < kTopicCount; ++i) {
+    const auto id = static_cast<TopicId>(i);
+    const std::string& name = config_.topics[id];
+    topics_[i] = participant_->create_topic(name, type_name_of(id), fdds::TOPIC_QOS_DEFAULT);
+    if (topics_[i] == nullptr) {
+      fail("creating topic '" + name + "' (" + std::string(to_string(id)) + ") failed");
+    }
+  }
+
+  fdds::PublisherQos pub_qos = participant_->get_default_publisher_qos();
+  for (const auto& p : config_.publisher_partitions) pub_qos.partition().push_back(p.c_str());
+  publisher_ = participant_->create_publisher(pub_qos);
+  if (publisher_ == nullptr) fail("creating publisher failed");
+
+  fdds::SubscriberQos sub_qos = participant_->get_default_subscriber_qos();
+  for (const auto& p : config_.subscriber_partitions) sub_qos.partition().push_back(p.c_str());
+  subscriber_ = participant_->create_subscriber(sub_qos);
+  if (subscriber_ == nullptr) fail("creating subscriber failed");
+}
+
+DdsContext::~DdsContext() = default;
+
+fdds::Topic& DdsContext::topic(TopicId id) const { return *topics_[index_of(id)]; }
+
+fdds::DataWriter& DdsContext::create_writer(TopicId id, const std::string& profile,
+                                            fdds::DataWriterListener* listener,
+                                            const fdds::StatusMask& mask) {
+  fdds::Topic* t = topics_[index_of(id)];
+  fdds::DataWriter* writer = publisher_->create_datawriter_with_profile(t, profile, listener, mask);
+  if (writer == nullptr) {
+    fail("creating data writer on topic '" + t->get_name() + "' from profile '" + profile +
+         "' failed");
+  }
+  return *writer;
+}
+
+fdds::DataReader& DdsContext::create_reader(TopicId id, const std::string& profile,
+                                            fdds::DataReaderListener* listener,
+                                            const fdds::StatusMask& mask) {
+  fdds::Topic* t = topics_[index_of(id)];
+  fdds::DataReader* reader = subscriber_->create_datareader_with_profile(t, profile, listener, mask);
+  if (reader == nullptr) {
+    fail("creating data reader on topic '" + t->get_name() + "' from profile '" + profile +
+         "' failed");
+  }
+  return *reader;
+}
+
+void DdsContext::delete_writer(fdds::DataWriter& writer) {
+  if (publisher_->delete_datawriter(&writer) != ReturnCode_t::RETCODE_OK) {
+    fail("deleting data writer failed");
+  }
+}
+
+void DdsContext::delete_reader(fdds::DataReader& reader) {
+  if (subscriber_->delete_datareader(&reader) != ReturnCode_t::RETCODE_OK) {
+    fail("deleting data reader failed");
+  }
+}
+
+}  // namespace usv_fdi::dds

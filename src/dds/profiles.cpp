@@ -1,0 +1,68 @@
+#include "usv_fdi/dds/profiles.hpp"
+
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastrtps/types/TypesBase.h>
+
+namespace usv_fdi::dds {
+namespace {
+
+using eprosima::fastdds::dds::DomainParticipantFactory;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+std::mutex& registry_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// Files this process has loaded successfully. Fast DDS 2.9 rejects a second load of the same
+// file (its profile names already exist), so loading is made idempotent here.
+std::set<std::string>& loaded_files() {
+  static std::set<std::string> files;
+  return files;
+}
+
+DomainParticipantFactory& factory() {
+  DomainParticipantFactory* f = DomainParticipantFactory::get_instance();
+  if (f == nullptr) {
+    throw std::runtime_error("usv_fdi::dds: DomainParticipantFactory::get_instance() returned null");
+  }
+  return *f;
+}
+
+void load_default_profiles_locked() {
+  // Loads FASTRTPS_DEFAULT_PROFILES_FILE (or ./DEFAULT_FASTRTPS_PROFILES.xml) once per process.
+  if (factory().load_profiles() != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error(
+        "usv_fdi::dds: loading the default Fast DDS profiles failed "
+        "(FASTRTPS_DEFAULT_PROFILES_FILE / DEFAULT_FASTRTPS_PROFILES.xml)");
+  }
+}
+
+}  // namespace
+
+void load_default_profiles() {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  load_default_profiles_locked();
+}
+
+void load_profiles_file(const std::string& path) {
+  if (path.empty()) {
+    throw std::invalid_argument("usv_fdi::dds: empty XML profiles file path");
+  }
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  load_default_profiles_locked();
+  if (loaded_files().count(path) != 0) return;
+  if (factory().load_XML_profiles_file(path) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("usv_fdi::dds: Fast DDS rejected the XML profiles file '" + path +
+                             "' (missing, malformed or duplicate profile names; see the Fast DDS "
+                             "error log)");
+  }
+  loaded_files().insert(path);
+}
+
+}  // namespace usv_fdi::dds
