@@ -62,6 +62,7 @@ void IsolationParams::validate() const {
   require(clip > 1, "clip", clip, "must be > 1");
   require(threshold > 1, "threshold", threshold, "must be > 1 (healthy J_N is about 1)");
   require(threshold_k > 0, "threshold_k", threshold_k, "must be > 0");
+  require(threshold_margin >= 1, "threshold_margin", threshold_margin, "must be >= 1");
   require(exit_ratio > 0 && exit_ratio <= 1, "exit_ratio", exit_ratio, "must lie in (0, 1]");
   require(exit_ratio * threshold > 1, "exit_ratio", exit_ratio,
           "exit_ratio * threshold must exceed 1 (healthy J_N is about 1)");
@@ -220,7 +221,8 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
                  !std::isfinite(s.v) || !std::isfinite(s.r) || !std::isfinite(s.delta);
   for (const Condition& c : cond_) suspect = suspect || c.active;
   if (st_.armed && !st_.learning && !st_.settling) {
-    suspect = suspect || st_.J.maxCoeff() > p_.exit_ratio * st_.threshold;
+    suspect = suspect || st_.J.maxCoeff() > p_.exit_ratio * st_.threshold ||
+              st_.D.maxCoeff() > p_.exit_ratio * st_.threshold;
   }
   if (suspect) t_last_suspect_ = s.t;
   freeze_ = s.t - t_last_suspect_ < p_.resume_time;
@@ -395,15 +397,20 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
 
   if (!scales_learned_) {
     if (win_s_[0].v.size() >= n && win_s_[1].v.size() >= n) {
-      learn_J_.push_back(st_.J(0));
-      learn_J_.push_back(st_.J(1));
+      for (int c = 0; c < 2; ++c) {
+        learn_J_.push_back(st_.J(c));
+        learn_J_.push_back(st_.D(c));
+      }
     }
     if (s.t - t_learn0 >= p_.learn_time) {
       const double med = median(&learn_J_);
       const double sd = robust_std(&learn_J_);
+      std::sort(learn_J_.begin(), learn_J_.end());
+      const double q999 = learn_J_.empty() ? 0.0 : learn_J_[learn_J_.size() * 999 / 1000];
       // J_N of clipped residuals cannot exceed clip^2: keep the threshold reachable.
-      st_.threshold = std::min(std::max(p_.threshold, med + p_.threshold_k * sd),
-                               0.75 * p_.clip * p_.clip);
+      st_.threshold =
+          std::min(std::max({p_.threshold, med + p_.threshold_k * sd, p_.threshold_margin * q999}),
+                   0.75 * p_.clip * p_.clip);
       std::vector<double>().swap(learn_J_);
       scales_learned_ = true;
       st_.learning = false;
@@ -487,10 +494,12 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       above_since_[k] = kNaN;
     }
   }
-  // Hold / clear: a raised sensor stays while its structured or cross statistic is high.
+  // Hold / clear. While sensor i is faulty its dedicated observer is reconfigured (driven by
+  // the other observer), so its structured entry no longer has the healthy scale; the cross
+  // residual d_i = y_i - x_i(observer blind to i) carries the fault without absorption.
   for (int k = 0; k < 3; ++k) {
     if (!(cond_[k].sources & kResidual) || k == candidate) continue;
-    const double hold = k < 2 ? std::max(st_.J(k), st_.D(k)) : st_.J.maxCoeff();
+    const double hold = k < 2 ? st_.D(k) : st_.J.maxCoeff();
     if (hold < thr_exit) {
       if (std::isnan(below_since_[k])) below_since_[k] = s.t;
       if (s.t - below_since_[k] + eps_t >= p_.leave_time) {

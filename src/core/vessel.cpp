@@ -37,8 +37,10 @@ VesselModel make_otter() {
   m.A << -0.883024, -0.438614, -1.55172, -1.16124;
   m.B << 0.165394, -2.19400;
   m.max_rudder = 40.0 * kDeg;
-  m.max_rudder_rate = 20.0 * kDeg;
-  m.rudder_time_constant = 0.1;
+  // The thrusters answer in 0.1 s, but the equivalent rudder of a differential-thrust
+  // yaw moment is rate-limited here (10 deg/s, 0.3 s lag) like a real steering servo.
+  m.max_rudder_rate = 10.0 * kDeg;
+  m.rudder_time_constant = 0.3;
   m.autopilot_bandwidth = 0.6;
   m.turn_angle = 20.0 * kDeg;
   m.turn_period = 20.0;

@@ -19,8 +19,8 @@ std::mutex& registry_mutex() {
   return m;
 }
 
-// Files this process has loaded successfully. Fast DDS 2.9 rejects a second load of the same
-// file (its profile names already exist), so loading is made idempotent here.
+// Files this process has loaded successfully. (Fast DDS 2.9 itself skips a path it has already
+// parsed; keeping our own record makes the idempotence explicit and version independent.)
 std::set<std::string>& loaded_files() {
   static std::set<std::string> files;
   return files;

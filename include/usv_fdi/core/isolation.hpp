@@ -36,11 +36,12 @@ struct IsolationParams {
   double sigma_floor_v = 1e-4;  ///< floor of every v-channel scale [m/s]
   double sigma_floor_r = 1e-5;  ///< floor of every r-channel scale [rad/s]
   double settle_time = -1;  ///< observer settling after arming [s]; <0: 3 / min|pole|
-  double learn_time = 10.0;  ///< healthy data used to learn scales and threshold [s]
+  double learn_time = 60.0;  ///< healthy data used to learn scales and threshold [s]
   double window = 0.5;       ///< evaluation window J_N [s]
   int min_window_samples = 10;  ///< the window holds at least this many samples
   double clip = 4.0;         ///< whitened residuals are clipped to +-clip inside J_N
-  double threshold = 6.0;    ///< minimum enter threshold on J_N (whitened mean square)
+  double threshold = 6.0;    ///< minimum enter threshold on J_N, D_N (whitened mean square)
+  double threshold_margin = 1.5;  ///< learned threshold: at least margin * 99.9 % quantile
   double threshold_k = 8.0;  ///< learned threshold: median + k robust std of healthy J_N
   double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
   double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]

@@ -36,7 +36,11 @@ inline constexpr const char* kStatusReader = "usv_fdi_status_reader";
 /// in the working directory) are loaded, then loads `path` into the process-wide Fast DDS profile
 /// registry. A file that was already loaded successfully by this function is not parsed again.
 /// Throws std::runtime_error naming the file when Fast DDS rejects it (unreadable, malformed XML,
-/// unknown element, duplicate profile name, ...). Thread-safe.
+/// unknown element or bad value, ...). Thread-safe.
+///
+/// Precedence: profiles loaded first win. The default profiles file is loaded before `path`, so a
+/// profile it defines under one of our names overrides ours. Caveat (Fast DDS 2.9): a duplicate
+/// profile name or transport id only logs an XMLPARSER error; the load still reports success.
 void load_profiles_file(const std::string& path);
 
 /// Loads only the default profiles (see above). Throws std::runtime_error on failure.
