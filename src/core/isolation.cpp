@@ -68,6 +68,7 @@ void IsolationParams::validate() const {
           "exit_ratio * threshold must exceed 1 (healthy J_N is about 1)");
   require(enter_time >= 0, "enter_time", enter_time, "must be >= 0");
   require(leave_time >= 0, "leave_time", leave_time, "must be >= 0");
+  require(min_active_time >= 0, "min_active_time", min_active_time, "must be >= 0");
   require(c_min > 0 && c_min <= 1, "c_min", c_min, "must lie in (0, 1]");
   require(c_margin >= 0 && c_margin < 1, "c_margin", c_margin, "must lie in [0, 1)");
   require(resume_time >= 0, "resume_time", resume_time, "must be >= 0");
@@ -145,6 +146,16 @@ void Isolator::set_estimate(const Estimate& est) {
   if ((est.A - st_.A_design).norm() > p_.redesign_tolerance * ref) design(est.A);
 }
 
+double Isolator::learned_threshold(std::vector<double>* healthy) const {
+  const double med = median(healthy);
+  const double sd = robust_std(healthy);
+  std::sort(healthy->begin(), healthy->end());
+  const double q999 = healthy->empty() ? 0.0 : (*healthy)[healthy->size() * 999 / 1000];
+  // A windowed mean of clipped squares cannot exceed clip^2: keep the threshold reachable.
+  return std::min(std::max({p_.threshold, med + p_.threshold_k * sd, p_.threshold_margin * q999}),
+                  0.75 * p_.clip * p_.clip);
+}
+
 std::size_t Isolator::window_samples(double dt) const {
   const double n = dt > 0 ? std::round(p_.window / dt) : p_.min_window_samples;
   return static_cast<std::size_t>(std::max<double>(n, p_.min_window_samples));
@@ -159,9 +170,9 @@ Detection Isolator::make_detection(Sensor sensor, bool active, FaultKind kind, d
   d.c_g = st_.c_g;
   d.threshold = st_.threshold;
   if (sensor == Sensor::kAccelerometer) {
-    d.statistic = std::max(st_.J(0), st_.D(0));
+    d.statistic = active ? st_.J(0) : st_.D(0);
   } else if (sensor == Sensor::kGyro) {
-    d.statistic = std::max(st_.J(1), st_.D(1));
+    d.statistic = active ? st_.J(1) : st_.D(1);
   } else {
     d.statistic = st_.J.maxCoeff();
   }
@@ -222,7 +233,7 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   for (const Condition& c : cond_) suspect = suspect || c.active;
   if (st_.armed && !st_.learning && !st_.settling) {
     suspect = suspect || st_.J.maxCoeff() > p_.exit_ratio * st_.threshold ||
-              st_.D.maxCoeff() > p_.exit_ratio * st_.threshold;
+              st_.D.maxCoeff() > p_.exit_ratio * st_.threshold_d;
   }
   if (suspect) t_last_suspect_ = s.t;
   freeze_ = s.t - t_last_suspect_ < p_.resume_time;
@@ -399,19 +410,14 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     if (win_s_[0].v.size() >= n && win_s_[1].v.size() >= n) {
       for (int c = 0; c < 2; ++c) {
         learn_J_.push_back(st_.J(c));
-        learn_J_.push_back(st_.D(c));
+        learn_D_.push_back(st_.D(c));
       }
     }
     if (s.t - t_learn0 >= p_.learn_time) {
-      const double med = median(&learn_J_);
-      const double sd = robust_std(&learn_J_);
-      std::sort(learn_J_.begin(), learn_J_.end());
-      const double q999 = learn_J_.empty() ? 0.0 : learn_J_[learn_J_.size() * 999 / 1000];
-      // J_N of clipped residuals cannot exceed clip^2: keep the threshold reachable.
-      st_.threshold =
-          std::min(std::max({p_.threshold, med + p_.threshold_k * sd, p_.threshold_margin * q999}),
-                   0.75 * p_.clip * p_.clip);
+      st_.threshold = learned_threshold(&learn_J_);
+      st_.threshold_d = learned_threshold(&learn_D_);
       std::vector<double>().swap(learn_J_);
+      std::vector<double>().swap(learn_D_);
       scales_learned_ = true;
       st_.learning = false;
     }
@@ -453,6 +459,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
 
   // Residual evaluation with hysteresis.
   const double thr = st_.threshold, thr_exit = p_.exit_ratio * st_.threshold;
+  const double thr_exit_d = p_.exit_ratio * st_.threshold_d;
   const double eps_t = 1e-9;
   const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual,
              u_res = cond_[2].sources & kResidual;
@@ -480,6 +487,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       if (s.t - above_since_[k] + eps_t >= p_.enter_time) {
         const Sensor sensor = static_cast<Sensor>(k);
         const FaultKind kind = k < 2 ? classify(k) : FaultKind::kUnknown;
+        if (k < 2) refine_at_[k] = s.t + 0.5 * p_.classify_window;
         std::string msg = k < 2 ? std::string("residual of the ") +
                                       (k == 0 ? "accelerometer" : "gyro") + " channel: J_N " +
                                       std::to_string(st_.J(k)) + " > " + std::to_string(thr)
@@ -487,6 +495,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
                                       std::to_string(st_.J.maxCoeff()) + " > " +
                                       std::to_string(thr);
         set_condition(sensor, kResidual, true, kind, s.t, msg, out);
+        raised_at_[k] = s.t;
         above_since_[k] = kNaN;
         below_since_[k] = kNaN;
       }
@@ -494,17 +503,39 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       above_since_[k] = kNaN;
     }
   }
+  // Refine the kind once more data after the raise shows the fault's shape.
+  for (int k = 0; k < 2; ++k) {
+    if (std::isnan(refine_at_[k]) || s.t < refine_at_[k]) continue;
+    refine_at_[k] = kNaN;
+    Condition& c = cond_[k];
+    if (!(c.sources & kResidual)) continue;
+    if (c.kind != FaultKind::kBias && c.kind != FaultKind::kDrift && c.kind != FaultKind::kScale) {
+      continue;
+    }
+    const FaultKind refined = classify_shape(k);
+    if (refined == c.kind) continue;
+    Detection d = make_detection(static_cast<Sensor>(k), true, refined, s.t);
+    d.update = true;
+    d.message = std::string("kind refined from ") + to_string(c.kind) + " to " + to_string(refined);
+    c.kind = refined;
+    out->push_back(d);
+  }
   // Hold / clear. While sensor i is faulty its dedicated observer is reconfigured (driven by
-  // the other observer), so its structured entry no longer has the healthy scale; the cross
+  // the other observer), so its structured entry takes the cross residual's scale; the cross
   // residual d_i = y_i - x_i(observer blind to i) carries the fault without absorption.
   for (int k = 0; k < 3; ++k) {
     if (!(cond_[k].sources & kResidual) || k == candidate) continue;
-    const double hold = k < 2 ? st_.D(k) : st_.J.maxCoeff();
-    if (hold < thr_exit) {
+    // The reconfigured observer's structured entry has about the cross residual's scale.
+    const double rescale =
+        k < 2 ? std::min(1.0, std::pow(st_.sigma_s(k) / st_.sigma_d(k), 2.0)) : 1.0;
+    const double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) : st_.J.maxCoeff();
+    if (hold < (k < 2 ? thr_exit_d : thr_exit)) {
       if (std::isnan(below_since_[k])) below_since_[k] = s.t;
-      if (s.t - below_since_[k] + eps_t >= p_.leave_time) {
+      if (s.t - below_since_[k] + eps_t >= p_.leave_time &&
+          s.t - raised_at_[k] + eps_t >= p_.min_active_time) {
         set_condition(static_cast<Sensor>(k), kResidual, false, cond_[k].kind, s.t,
-                      "residual back below " + std::to_string(thr_exit), out);
+                      "residual back below " + std::to_string(k < 2 ? thr_exit_d : thr_exit),
+                      out);
         below_since_[k] = kNaN;
       }
     } else {
@@ -530,6 +561,8 @@ double Isolator::onset_estimate(int ch, double t) const {
 }
 
 FaultKind Isolator::classify(int ch) const {
+  // 0. Stuck: the channel repeats its value exactly (a healthy, noisy sensor never does).
+  if (ch_[ch].stuck_samples >= 2) return FaultKind::kStuck;
   // 1. Spikes: the excess energy of the window sits in one or two samples.
   const auto& w = win_sl_[ch].v;
   if (w.empty()) return FaultKind::kUnknown;
@@ -549,51 +582,45 @@ FaultKind Isolator::classify(int ch) const {
   // 2. Noise increase: energy without a consistent sign.
   const double mean = sum / nw, ms = total / nw;
   if (mean * mean < 0.2 * ms) return FaultKind::kNoise;
-  // 3. Bias, drift or scale from the cross residual (the fault estimate) over the history.
+  return classify_shape(ch);
+}
+
+FaultKind Isolator::classify_shape(int ch) const {
+  // Bias, drift or scale from the cross residual d_i = f_i + noise (the fault estimate):
+  // best step  d = a + g 1(t >= tau), best hinge d = a + b max(0, t - tau), best scale
+  // d = a + k x 1(t >= tau) (x: the other observer's estimate of the channel).
   const auto& d = hist_d_[ch];
   const auto& x = hist_x_[ch];
   const std::size_t m = d.size();
-  if (m < 8) return FaultKind::kBias;
-  // Line fit d = a + b t versus best step fit and scale fit d = k x.
-  double st = 0, sd = 0, stt = 0, std_ = 0, sxx = 0, sxd = 0;
-  const double t0 = d.front().first;
-  for (std::size_t i = 0; i < m; ++i) {
-    const double ti = d[i].first - t0, di = d[i].second, xi = x[i].second;
-    st += ti;
-    sd += di;
-    stt += ti * ti;
-    std_ += ti * di;
-    sxx += xi * xi;
-    sxd += xi * di;
+  if (m < 8 || x.size() != m) return FaultKind::kBias;
+  // Two-regressor least squares with intercept: SSE of d on [1, z].
+  const auto sse2 = [&](const std::vector<double>& z) {
+    double sz = 0, szz = 0, sd = 0, sdd = 0, szd = 0;
+    for (std::size_t i = 0; i < m; ++i) {
+      sz += z[i];
+      szz += z[i] * z[i];
+      sd += d[i].second;
+      sdd += d[i].second * d[i].second;
+      szd += z[i] * d[i].second;
+    }
+    const double n = static_cast<double>(m);
+    const double vzz = szz - sz * sz / n, vdd = sdd - sd * sd / n, vzd = szd - sz * sd / n;
+    return vzz > 0 ? vdd - vzd * vzd / vzz : vdd;
+  };
+  double best_step = 1e300, best_hinge = 1e300, best_scale = 1e300;
+  std::vector<double> z(m);
+  const std::size_t stride = std::max<std::size_t>(1, m / 100);
+  for (std::size_t k = 1; k + 2 < m; k += stride) {
+    const double tau = d[k].first;
+    for (std::size_t i = 0; i < m; ++i) z[i] = i >= k ? 1.0 : 0.0;
+    best_step = std::min(best_step, sse2(z));
+    for (std::size_t i = 0; i < m; ++i) z[i] = std::max(0.0, d[i].first - tau);
+    best_hinge = std::min(best_hinge, sse2(z));
+    for (std::size_t i = 0; i < m; ++i) z[i] = i >= k ? x[i].second : 0.0;
+    best_scale = std::min(best_scale, sse2(z));
   }
-  const double md = static_cast<double>(m);
-  const double den = md * stt - st * st;
-  const double b = den > 0 ? (md * std_ - st * sd) / den : 0.0;
-  const double a = (sd - b * st) / md;
-  const double kx = sxx > 0 ? sxd / sxx : 0.0;
-  double sse_line = 0, sse_scale = 0;
-  for (std::size_t i = 0; i < m; ++i) {
-    const double ti = d[i].first - t0, di = d[i].second;
-    sse_line += (di - a - b * ti) * (di - a - b * ti);
-    sse_scale += (di - kx * x[i].second) * (di - kx * x[i].second);
-  }
-  // Best single step: prefix means.
-  double sse_step = 1e300, pre = 0, pre2 = 0, tot = 0, tot2 = 0;
-  for (const auto& p : d) {
-    tot += p.second;
-    tot2 += p.second * p.second;
-  }
-  for (std::size_t k = 1; k + 1 < m; ++k) {
-    pre += d[k - 1].second;
-    pre2 += d[k - 1].second * d[k - 1].second;
-    const double n1 = static_cast<double>(k), n2 = md - n1;
-    const double post = tot - pre, post2 = tot2 - pre2;
-    const double sse = (pre2 - pre * pre / n1) + (post2 - post * post / n2);
-    sse_step = std::min(sse_step, sse);
-  }
-  // The line must beat the step clearly to call a drift (a step is the simpler story).
-  if (sse_scale < 0.5 * std::min(sse_line, sse_step)) return FaultKind::kScale;
-  if (sse_line < 0.7 * sse_step && std::abs(b) > 0) return FaultKind::kDrift;
+  if (best_scale < 0.6 * std::min(best_step, best_hinge)) return FaultKind::kScale;
+  if (best_hinge < 0.8 * best_step) return FaultKind::kDrift;
   return FaultKind::kBias;
 }
 

@@ -24,7 +24,18 @@ bool FaultLatch::on_detection(const Detection& d, const Mat2& A, FaultEvent* eve
     if (s == FaultState::kRaised) next = FaultState::kClearedUnacknowledged;
     if (s == FaultState::kActiveAcknowledged) next = FaultState::kAcknowledged;
   }
-  if (next == s) return false;
+  if (next == s) {
+    // A refined kind of a raised fault is published (same state, next sequence).
+    const bool raised = s == FaultState::kRaised || s == FaultState::kActiveAcknowledged;
+    if (!(d.active && d.update && raised && d.kind != ev_.kind)) return false;
+    ev_.kind = d.kind;
+    ev_.t = d.detection_time;
+    ev_.A = A;
+    ev_.message = d.message;
+    ++ev_.sequence;
+    *event = ev_;
+    return true;
+  }
   ev_.state = next;
   ev_.t = d.detection_time;
   ev_.statistic = d.statistic;

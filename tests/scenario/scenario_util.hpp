@@ -74,6 +74,7 @@ inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r,
       s.detected = true;
       s.isolated = e.sensor == f.sensor;
       s.kind = e.kind;
+      for (const FaultEvent& u : r.events) if (u.sensor == e.sensor && u.t > e.t && u.t <= f.t_end + grace && u.message.rfind("kind refined", 0) == 0) s.kind = u.kind;
       s.delay = e.t - f.t_start;
       for (const FaultEvent& c : r.events) {
         if (c.sensor == e.sensor && c.t > e.t &&

@@ -46,6 +46,7 @@ struct IsolationParams {
   double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
   double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]
   double leave_time = 1.0;   ///< below the leave threshold this long clears [s]
+  double min_active_time = 3.0;  ///< a residual fault stays raised at least this long [s]
   double c_min = 0.8;        ///< isolation needs C_i >= c_min ...
   double c_margin = 0.3;     ///< ... and C_i - C_other >= c_margin; else sensor unknown
   double resume_time = 2.0;  ///< quiet time before identification resumes [s]
@@ -60,7 +61,7 @@ struct IsolationParams {
   double spike_window = 3.0;   ///< spikes are counted over this window [s]
   int spike_count = 3;         ///< this many spikes in the window raise a spikes fault
   int invalid_count = 3;       ///< this many invalid values in spike_window raise invalid
-  double classify_window = 4.0;  ///< history used to name the kind of a fault [s]
+  double classify_window = 8.0;  ///< history used to name the kind of a fault [s]
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
@@ -70,6 +71,7 @@ struct IsolationParams {
 struct Detection {
   Sensor sensor = Sensor::kUnknown;
   bool active = false;  ///< true: condition raised; false: condition cleared
+  bool update = false;  ///< a raised condition's kind was refined (no state change)
   FaultKind kind = FaultKind::kUnknown;
   double c_a = 0.0, c_g = 0.0;
   double statistic = 0.0, threshold = 0.0;
@@ -96,6 +98,7 @@ struct IsolatorStatus {
   Vec2 sigma_s = Vec2::Zero();  ///< scales of the structured residual [m/s, rad/s]
   Vec2 sigma_d = Vec2::Zero();  ///< scales of the cross residual
   double threshold = 0.0;       ///< enter threshold on J_N in force
+  double threshold_d = 0.0;     ///< threshold on the cross statistic D_N (hold: exit_ratio x)
   Vec2 J = Vec2::Zero();        ///< windowed statistic per channel (structured)
   Vec2 D = Vec2::Zero();        ///< windowed statistic per channel (cross)
   double c_a = 0.0, c_g = 0.0;
@@ -157,8 +160,10 @@ class Isolator {
   void sensor_checks(const Sample& s, std::vector<Detection>* out);
   void residual_checks(const Sample& s, double dt, std::vector<Detection>* out);
   FaultKind classify(int ch) const;
+  FaultKind classify_shape(int ch) const;
   double onset_estimate(int ch, double t) const;
   std::size_t window_samples(double dt) const;
+  double learned_threshold(std::vector<double>* healthy) const;
 
   IsolationParams p_;
   Vec2 B_;
@@ -178,7 +183,7 @@ class Isolator {
   // Learning samples (robust statistics: a fault during learning cannot inflate the scales
   // unless it covers half of the learning time).
   std::array<std::vector<double>, 4> learn_raw_;  ///< s_a, s_g, d_a, d_g raw residuals
-  std::vector<double> learn_J_;
+  std::vector<double> learn_J_, learn_D_;
   std::array<Window, 2> win_s_;   ///< clipped squared structured residuals
   std::array<Window, 2> win_sl_;  ///< signed structured residuals (classification)
   std::array<Window, 2> win_d_;   ///< clipped squared cross residuals
@@ -189,7 +194,9 @@ class Isolator {
   std::array<Condition, 3> cond_;  ///< accelerometer, gyro, unknown
   std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown
   std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
+  std::array<double, 3> raised_at_{kNaN, kNaN, kNaN};  ///< time of the residual raise
   double last_delta_ = kNaN;
+  std::array<double, 2> refine_at_{kNaN, kNaN};  ///< when to refine a raised fault's kind
 };
 
 }  // namespace usvfdi
