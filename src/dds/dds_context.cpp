@@ -4,12 +4,12 @@
 #include <string>
 #include <utility>
 
+#include <fastrtps/types/TypesBase.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/dds/topic/qos/TopicQos.hpp>
-#include <fastrtps/types/TypesBase.h>
 
 namespace usv_fdi::dds {
 namespace {
@@ -93,7 +93,8 @@ void throw_write_failed(const fdds::DataWriter& writer) {
 }
 }  // namespace detail
 
-void DdsContext::ParticipantDeleter::operator()(fdds::DomainParticipant* participant) const noexcept {
+void DdsContext::ParticipantDeleter::operator()(
+    fdds::DomainParticipant* participant) const noexcept {
   if (participant == nullptr) return;
   // Errors cannot be reported from a destructor; Fast DDS logs them.
   (void)participant->delete_contained_entities();
@@ -111,8 +112,8 @@ DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
   participant_.reset(factory->create_participant_with_profile(
       static_cast<fdds::DomainId_t>(config_.domain_id), config_.participant_profile));
   if (!participant_) {
-    fail("creating participant on domain " + std::to_string(config_.domain_id) +
-         " from profile '" + config_.participant_profile + "' failed");
+    fail("creating participant on domain " + std::to_string(config_.domain_id) + " from profile '" +
+         config_.participant_profile + "' failed");
   }
 
   register_type<fdi::InsSamplePubSubType>(*participant_);
@@ -161,7 +162,8 @@ fdds::DataReader& DdsContext::create_reader(TopicId id, const std::string& profi
                                             fdds::DataReaderListener* listener,
                                             const fdds::StatusMask& mask) {
   fdds::Topic* t = topics_[index_of(id)];
-  fdds::DataReader* reader = subscriber_->create_datareader_with_profile(t, profile, listener, mask);
+  fdds::DataReader* reader =
+      subscriber_->create_datareader_with_profile(t, profile, listener, mask);
   if (reader == nullptr) {
     fail("creating data reader on topic '" + t->get_name() + "' from profile '" + profile +
          "' failed");

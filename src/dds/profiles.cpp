@@ -5,8 +5,8 @@
 #include <stdexcept>
 #include <string>
 
-#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastrtps/types/TypesBase.h>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 
 namespace usv_fdi::dds {
 namespace {
@@ -29,7 +29,8 @@ std::set<std::string>& loaded_files() {
 DomainParticipantFactory& factory() {
   DomainParticipantFactory* f = DomainParticipantFactory::get_instance();
   if (f == nullptr) {
-    throw std::runtime_error("usv_fdi::dds: DomainParticipantFactory::get_instance() returned null");
+    throw std::runtime_error(
+        "usv_fdi::dds: DomainParticipantFactory::get_instance() returned null");
   }
   return *f;
 }

@@ -113,7 +113,8 @@ namespace detail {
 [[noreturn]] void throw_write_failed(const eprosima::fastdds::dds::DataWriter& writer);
 }  // namespace detail
 
-/// Writes one sample; throws std::runtime_error if Fast DDS refuses it (e.g. a reliable writer
+/// Writes one sample. `writer` must belong to T's topic (not checked: Fast DDS takes a void*).
+/// Throws std::runtime_error if Fast DDS refuses it (e.g. a reliable writer
 /// blocked longer than max_blocking_time, or resource limits reached).
 template <class T>
 void write(eprosima::fastdds::dds::DataWriter& writer, const T& sample) {

@@ -11,6 +11,7 @@ namespace profiles {
 // Participants.
 inline constexpr const char* kParticipant = "usv_fdi_participant";  // builtin transports (SHM+UDP)
 inline constexpr const char* kParticipantLoopback = "usv_fdi_participant_loopback";  // UDPv4 on lo
+inline constexpr const char* kParticipantShm = "usv_fdi_participant_shm";  // shared memory only
 // INS samples.
 inline constexpr const char* kInsWriterBestEffort = "usv_fdi_ins_writer_best_effort";
 inline constexpr const char* kInsReaderBestEffort = "usv_fdi_ins_reader_best_effort";
@@ -32,11 +33,11 @@ inline constexpr const char* kStatusWriter = "usv_fdi_status_writer";
 inline constexpr const char* kStatusReader = "usv_fdi_status_reader";
 }  // namespace profiles
 
-/// Makes sure the default profiles (FASTRTPS_DEFAULT_PROFILES_FILE, or DEFAULT_FASTRTPS_PROFILES.xml
-/// in the working directory) are loaded, then loads `path` into the process-wide Fast DDS profile
-/// registry. A file that was already loaded successfully by this function is not parsed again.
-/// Throws std::runtime_error naming the file when Fast DDS rejects it (unreadable, malformed XML,
-/// unknown element or bad value, ...). Thread-safe.
+/// Makes sure the default profiles (FASTRTPS_DEFAULT_PROFILES_FILE, or
+/// DEFAULT_FASTRTPS_PROFILES.xml in the working directory) are loaded, then loads `path` into the
+/// process-wide Fast DDS profile registry. A file that was already loaded successfully by this
+/// function is not parsed again. Throws std::runtime_error naming the file when Fast DDS rejects it
+/// (unreadable, malformed XML, unknown element or bad value, ...). Thread-safe.
 ///
 /// Precedence: profiles loaded first win. The default profiles file is loaded before `path`, so a
 /// profile it defines under one of our names overrides ours. Caveat (Fast DDS 2.9): a duplicate

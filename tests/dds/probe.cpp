@@ -1,0 +1,256 @@
+// usv_fdi_dds_probe: helper process for the DDS integration tests.
+//
+//   usv_fdi_dds_probe publish-faults --profiles FILE [--domain N] [--participant-profile P]
+//       [--partition NAME] [--vessels M] [--sensors S] [--state X] [--rewrite-state Y]
+//       [--mmsi-base B] [--timeout SECONDS]
+//     Writes one FaultEvent per (vessel, sensor) with the given state (sequence 1); with
+//     --rewrite-state also rewrites instance (mmsi-base, sensor 0) with state Y (sequence 2).
+//     Prints "published instances=I writes=W" and stays alive until SIGTERM/SIGINT (exit 0) or
+//     the timeout (exit 2).
+//
+//   usv_fdi_dds_probe read-faults --profiles FILE [--domain N] [--participant-profile P]
+//       [--partition NAME] --expect K [--timeout SECONDS] [--settle-ms MS]
+//     Late-joining reader: waits until K distinct instances were received (then --settle-ms more
+//     for stray samples), prints one line per instance
+//       instance mmsi=.. sensor=.. state=.. kind=.. sequence=.. samples=.. message=..
+//     and exits 0; exits 1 on timeout (after printing what it has).
+//
+// Exit code 3: usage error; 4: DDS error.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <map>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/core/status/StatusMask.hpp>
+
+#include "usv_fdi/dds/dds_context.hpp"
+
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using usv_fdi::dds::DdsConfig;
+using usv_fdi::dds::DdsContext;
+namespace profiles = usv_fdi::dds::profiles;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "signal flag must be lock free");
+
+extern "C" void on_signal(int) { g_stop.store(true); }  // no I/O, async-signal-safe
+
+struct Options {
+  std::string mode;
+  DdsConfig dds;
+  unsigned vessels = 3;
+  unsigned sensors = 2;
+  unsigned state = 1;
+  std::optional<unsigned> rewrite_state;
+  std::uint32_t mmsi_base = 257000000;
+  double timeout_s = 30.0;
+  unsigned expect = 0;
+  unsigned settle_ms = 300;
+};
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+unsigned long parse_unsigned(const std::string& flag, const std::string& value) {
+  try {
+    std::size_t used = 0;
+    const unsigned long v = std::stoul(value, &used);
+    if (used != value.size()) throw std::invalid_argument(value);
+    return v;
+  } catch (const std::exception&) {
+    throw UsageError(flag + ": not an unsigned integer: '" + value + "'");
+  }
+}
+
+Options parse(int argc, char** argv) {
+  if (argc < 2) throw UsageError("missing mode (publish-faults | read-faults)");
+  Options o;
+  o.mode = argv[1];
+  if (o.mode != "publish-faults" && o.mode != "read-faults") {
+    throw UsageError("unknown mode '" + o.mode + "'");
+  }
+  for (int i = 2; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (i + 1 >= argc) throw UsageError(flag + ": missing value");
+    const std::string value = argv[++i];
+    if (flag == "--profiles") {
+      o.dds.profiles_file = value;
+    } else if (flag == "--domain") {
+      o.dds.domain_id = static_cast<std::uint32_t>(parse_unsigned(flag, value));
+    } else if (flag == "--participant-profile") {
+      o.dds.participant_profile = value;
+    } else if (flag == "--partition") {
+      o.dds.publisher_partitions.push_back(value);
+      o.dds.subscriber_partitions.push_back(value);
+    } else if (flag == "--vessels") {
+      o.vessels = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--sensors") {
+      o.sensors = static_cast<unsigned>(parse_unsigned(flag, value));
+      if (o.sensors < 1 || o.sensors > 3) throw UsageError("--sensors must be 1..3");
+    } else if (flag == "--state") {
+      o.state = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--rewrite-state") {
+      o.rewrite_state = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--mmsi-base") {
+      o.mmsi_base = static_cast<std::uint32_t>(parse_unsigned(flag, value));
+    } else if (flag == "--timeout") {
+      try {
+        o.timeout_s = std::stod(value);
+      } catch (const std::exception&) {
+        throw UsageError("--timeout: not a number: '" + value + "'");
+      }
+    } else if (flag == "--expect") {
+      o.expect = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--settle-ms") {
+      o.settle_ms = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else {
+      throw UsageError("unknown option '" + flag + "'");
+    }
+  }
+  if (o.dds.profiles_file.empty()) throw UsageError("--profiles is required");
+  if (o.mode == "read-faults" && o.expect == 0) throw UsageError("--expect must be > 0");
+  return o;
+}
+
+Clock::time_point deadline_after(double seconds) {
+  return Clock::now() +
+         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGINT, &sa, nullptr);
+}
+
+fdi::FaultEvent make_event(std::uint32_t mmsi, unsigned sensor, unsigned state,
+                           std::uint64_t sequence) {
+  fdi::FaultEvent e;
+  e.mmsi(mmsi);
+  e.sensor(static_cast<std::uint8_t>(sensor));
+  e.state(static_cast<std::uint8_t>(state));
+  e.kind(fdi::KIND_BIAS);
+  e.c_a(0.1 * sensor);
+  e.c_g(0.2 * sensor);
+  e.statistic(12.5);
+  e.threshold(10.0);
+  e.onset_time(100.0);
+  e.detection_time(101.5);
+  e.sequence(sequence);
+  e.a({1.0, 0.0, 0.0, 1.0});
+  e.message("probe " + std::to_string(mmsi) + "/" + std::to_string(sensor) + " seq " +
+            std::to_string(sequence));
+  return e;
+}
+
+int publish_faults(const Options& o) {
+  install_signal_handlers();
+  const auto deadline = deadline_after(o.timeout_s);
+  DdsContext ctx(o.dds);
+  fdds::DataWriter& writer = ctx.create_writer<fdi::FaultEvent>(profiles::kFaultEventWriter);
+  unsigned writes = 0;
+  for (unsigned v = 0; v < o.vessels; ++v) {
+    for (unsigned s = 0; s < o.sensors; ++s) {
+      usv_fdi::dds::write(writer, make_event(o.mmsi_base + v, s, o.state, 1));
+      ++writes;
+    }
+  }
+  if (o.rewrite_state) {
+    usv_fdi::dds::write(writer, make_event(o.mmsi_base, 0, *o.rewrite_state, 2));
+    ++writes;
+  }
+  std::printf("published instances=%u writes=%u\n", o.vessels * o.sensors, writes);
+  std::fflush(stdout);
+  while (!g_stop.load() && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const bool by_signal = g_stop.load();
+  std::printf("stopping reason=%s\n", by_signal ? "signal" : "timeout");
+  std::fflush(stdout);
+  return by_signal ? 0 : 2;
+}
+
+struct Seen {
+  fdi::FaultEvent latest;
+  std::size_t samples = 0;
+};
+
+int read_faults(const Options& o) {
+  const auto deadline = deadline_after(o.timeout_s);
+  DdsContext ctx(o.dds);
+  fdds::DataReader& reader = ctx.create_reader<fdi::FaultEvent>(profiles::kFaultEventReader);
+
+  fdds::StatusCondition& condition = reader.get_statuscondition();
+  condition.set_enabled_statuses(fdds::StatusMask::data_available());
+  fdds::WaitSet waitset;
+  waitset.attach_condition(condition);
+
+  std::map<std::pair<std::uint32_t, unsigned>, Seen> seen;
+  std::optional<Clock::time_point> settle_until;
+  std::vector<fdi::FaultEvent> batch;
+  for (;;) {
+    const auto now = Clock::now();
+    if (settle_until ? now >= *settle_until : now >= deadline) break;
+    // Bounded wait; the take below also runs on timeout (polling fallback).
+    fdds::ConditionSeq active;
+    (void)waitset.wait(active, eprosima::fastrtps::Duration_t(0, 100000000));
+    batch.clear();
+    usv_fdi::dds::take_all(reader, batch);
+    for (const auto& e : batch) {
+      Seen& s = seen[{e.mmsi(), static_cast<unsigned>(e.sensor())}];
+      if (s.samples == 0 || e.sequence() >= s.latest.sequence()) s.latest = e;
+      ++s.samples;
+    }
+    if (!settle_until && seen.size() >= o.expect) {
+      settle_until = Clock::now() + std::chrono::milliseconds(o.settle_ms);
+    }
+  }
+  (void)waitset.detach_condition(condition);
+
+  for (const auto& [key, s] : seen) {
+    std::printf(
+        "instance mmsi=%u sensor=%u state=%u kind=%u sequence=%llu samples=%zu message=%s\n",
+        key.first, key.second, static_cast<unsigned>(s.latest.state()),
+        static_cast<unsigned>(s.latest.kind()),
+        static_cast<unsigned long long>(s.latest.sequence()), s.samples,
+        s.latest.message().c_str());
+  }
+  std::fflush(stdout);
+  if (seen.size() < o.expect) {
+    std::fprintf(stderr, "read-faults: timeout, saw %zu of %u instances\n", seen.size(), o.expect);
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Options o = parse(argc, argv);
+    return o.mode == "publish-faults" ? publish_faults(o) : read_faults(o);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "usv_fdi_dds_probe: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "usv_fdi_dds_probe: %s\n", e.what());
+    return 4;
+  }
+}

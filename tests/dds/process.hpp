@@ -1,0 +1,47 @@
+// Minimal child-process helper for the DDS tests: posix_spawn with stdout on a pipe, bounded
+// waits everywhere, SIGKILL + reap on destruction so a failing test never leaves a process behind.
+#pragma once
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace usv_fdi::dds::test {
+
+class ChildProcess {
+ public:
+  /// Spawns argv[0] with the given arguments; stdout is captured, stderr is inherited.
+  explicit ChildProcess(const std::vector<std::string>& argv);
+  ~ChildProcess();
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  pid_t pid() const noexcept { return pid_; }
+
+  /// Next stdout line (without '\n'), or nullopt on EOF or when `timeout` elapses.
+  std::optional<std::string> read_line(std::chrono::milliseconds timeout);
+  /// Everything remaining on stdout until EOF or `timeout`.
+  std::string read_all(std::chrono::milliseconds timeout);
+
+  /// True while the child has not exited (reaps it if it has).
+  bool running();
+  /// Sends `sig` to the child if it is still running.
+  void signal(int sig);
+  /// Waits up to `timeout` for the child to exit. Returns its exit code, 128+signal if it was
+  /// killed by a signal, or nullopt if it is still running.
+  std::optional<int> wait_exit(std::chrono::milliseconds timeout);
+
+ private:
+  bool fill(std::chrono::steady_clock::time_point deadline);
+
+  pid_t pid_ = -1;
+  int out_fd_ = -1;
+  bool eof_ = false;
+  std::string buffer_;
+  std::optional<int> exit_code_;
+};
+
+}  // namespace usv_fdi::dds::test
