@@ -1,5 +1,6 @@
 #include "usv_fdi/service/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -144,6 +145,17 @@ void FdiPipeline::process(const Sample& s) {
 
 void FdiPipeline::handle_ack(const AckInput& a) {
   FaultEvent ev;
+  if (!opt_.authorised_operators.empty() &&
+      std::find(opt_.authorised_operators.begin(), opt_.authorised_operators.end(), a.who) ==
+          opt_.authorised_operators.end()) {
+    log(2, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
+               " refused: operator '" + a.who + "' is not authorised");
+    return;
+  }
+  if (static_cast<int>(a.sensor) > 2) {
+    log(2, "ack refused: unknown sensor " + std::to_string(static_cast<int>(a.sensor)));
+    return;
+  }
   FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
   const std::uint64_t current = latch.current().sequence;
   const AckResult r = latch.acknowledge(a.sequence, last_t_, a.who, &ev);

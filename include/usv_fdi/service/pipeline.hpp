@@ -77,6 +77,8 @@ struct PipelineOptions {
   /// Blocking mode: the isolation thread waits for the identification thread after each
   /// sample, so results do not depend on scheduling (replay at full speed, tests).
   bool lockstep = false;
+  /// Operators allowed to acknowledge (empty: anyone who can write the ack topic).
+  std::vector<std::string> authorised_operators;
 };
 
 /// What the status topic reports.

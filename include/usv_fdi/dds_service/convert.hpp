@@ -1,0 +1,21 @@
+// Conversions between the core's plain structs and the generated DDS types.
+#pragma once
+
+#include <cstdint>
+
+#include "usv_fdi/core/latch.hpp"
+#include "usv_fdi/dds/types.hpp"
+#include "usv_fdi/service/pipeline.hpp"
+
+namespace usvfdi::service {
+
+fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi);
+/// Returns false (and leaves *out alone) when an octet holds no known sensor/state/kind.
+bool from_dds(const fdi::FaultEvent& e, FaultEvent* out);
+fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const IsolationParams& p);
+InsInput from_dds(const fdi::InsSample& s);
+RudderInput from_dds(const fdi::RudderSample& s);
+/// An unknown sensor octet is passed on as is: the isolation thread refuses it with a reason.
+AckInput from_dds(const fdi::FaultAck& a);
+
+}  // namespace usvfdi::service

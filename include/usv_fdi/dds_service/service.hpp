@@ -1,0 +1,64 @@
+// The usv-fdi sidecar: the FDI pipeline behind Fast DDS readers and writers.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "usv_fdi/core/engine.hpp"
+#include "usv_fdi/dds/dds_context.hpp"
+#include "usv_fdi/service/pipeline.hpp"
+
+namespace usvfdi::service {
+
+struct ServiceConfig {
+  EngineConfig engine;
+  PipelineOptions pipeline;
+  usv_fdi::dds::DdsConfig dds;
+  std::uint32_t mmsi = 0;  ///< the vessel this sidecar watches (required, > 0)
+  bool reliable_inputs = false;  ///< INS and rudder readers RELIABLE instead of BEST_EFFORT
+  std::string log_level = "info";
+  std::string config_file;  ///< where it was loaded from (for messages)
+};
+
+/// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
+///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
+///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
+///   reliable_inputs, status_rate [Hz], log_level, authorised_operators: [..],
+///   input_queue, rudder_wait, rudder_timeout, input_timeout.
+/// Throws usvfdi::io::ConfigError naming file, key, line and value.
+ServiceConfig load_service_config(const std::string& path);
+
+/// The QoS profiles file used when no config names one: $USV_FDI_QOS_PROFILES, else the
+/// file shipped in the source tree's config/qos/.
+std::string default_qos_profiles();
+
+class FdiService {
+ public:
+  using LogSink = FdiPipeline::LogSink;
+  /// Creates every DDS entity and the pipeline; throws std::runtime_error naming what failed.
+  FdiService(const ServiceConfig& cfg, LogSink log);
+  ~FdiService();
+  FdiService(const FdiService&) = delete;
+  FdiService& operator=(const FdiService&) = delete;
+
+  void start();
+  /// Stops the listeners' feed, drains and joins the threads, deletes the DDS entities.
+  void stop();
+  PipelineStatus status() const { return pipeline_->status(); }
+
+ private:
+  class Listener;
+  ServiceConfig cfg_;
+  LogSink log_;
+  std::unique_ptr<FdiPipeline> pipeline_;
+  std::unique_ptr<Listener> listener_;
+  std::unique_ptr<usv_fdi::dds::DdsContext> dds_;
+  eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
+  bool stopped_ = false;
+};
+
+}  // namespace usvfdi::service

@@ -1,0 +1,57 @@
+// JSON Lines output of a replay: one JSON object per line, each with a "type" field.
+//
+//   {"type":"event","t":..,"sensor":"accelerometer"|"gyro"|"unknown",
+//    "state":"raised"|"cleared"|"active_acknowledged"|"acknowledged","kind":"bias"|..,
+//    "c_a":..,"c_g":..,"statistic":..,"threshold":..,"onset_time":..,"detection_time":..,
+//    "sequence":n,"a":[a1,a2,a3,a4],"message":".."}
+//   {"type":"estimate","t":..,"a":[a1,a2,a3,a4],"converged":bool,"excitation":..,"armed":bool}
+//   {"type":"summary","samples":n,"rejected":n,"events":n,
+//    "raised":{"accelerometer":n,"gyro":n,"unknown":n},"final_a":[..],"converged":bool,
+//    "frozen_samples":n,"duration_s":..,"complete":bool[,"error":".."]}
+//
+// Numbers are written with %.9g; NaN and infinities as null. Hand-written (no JSON library).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include "usv_fdi/core/engine.hpp"
+
+namespace usvfdi::io {
+
+/// A JSON string literal (with the quotes): escapes '"', '\\' and control characters;
+/// bytes that are not valid UTF-8 become U+FFFD.
+std::string json_string(const std::string& s);
+/// A JSON number with %.9g, or null when x is not finite.
+std::string json_number(double x);
+
+/// What a replay did (the summary record).
+struct RunSummary {
+  std::uint64_t samples = 0;   ///< rows read
+  std::uint64_t rejected = 0;  ///< rows the engine rejected (time did not increase)
+  std::uint64_t events = 0;    ///< event records written
+  std::array<std::uint64_t, 3> raised{0, 0, 0};  ///< raised events per Sensor
+  Vec4 final_a = Vec4::Zero();
+  bool converged = false;
+  std::uint64_t frozen_samples = 0;
+  double duration_s = 0.0;  ///< last minus first sample time [s, data time]
+  bool complete = true;     ///< false: the input ended in an error
+  std::string error;        ///< that error (only when !complete)
+};
+
+class JsonlWriter {
+ public:
+  explicit JsonlWriter(std::ostream& out) : out_(out) {}
+  void event(const FaultEvent& e);
+  /// t: data time of the record [s] (the estimate itself may lag by the identification delay).
+  void estimate(double t, const Estimate& est, bool armed);
+  void summary(const RunSummary& s);
+  void flush();
+
+ private:
+  std::ostream& out_;
+};
+
+}  // namespace usvfdi::io

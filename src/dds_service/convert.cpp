@@ -1,0 +1,98 @@
+#include "usv_fdi/dds_service/convert.hpp"
+
+#include <string>
+
+namespace usvfdi::service {
+
+fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {
+  fdi::FaultEvent d;
+  d.mmsi(mmsi);
+  d.sensor(static_cast<std::uint8_t>(e.sensor));
+  d.state(static_cast<std::uint8_t>(e.state));
+  d.kind(static_cast<std::uint8_t>(e.kind));
+  d.c_a(e.c_a);
+  d.c_g(e.c_g);
+  d.statistic(e.statistic);
+  d.threshold(e.threshold);
+  d.onset_time(e.onset_time);
+  d.detection_time(e.detection_time);
+  d.sequence(e.sequence);
+  d.a({e.A(0, 0), e.A(0, 1), e.A(1, 0), e.A(1, 1)});
+  d.message(e.message.substr(0, 127).c_str());
+  return d;
+}
+
+bool from_dds(const fdi::FaultEvent& d, FaultEvent* out) {
+  if (d.sensor() > static_cast<std::uint8_t>(Sensor::kUnknown) ||
+      d.state() > static_cast<std::uint8_t>(FaultState::kAcknowledged) ||
+      d.kind() > static_cast<std::uint8_t>(FaultKind::kInvalid)) {
+    return false;
+  }
+  FaultEvent e;
+  e.sensor = static_cast<Sensor>(d.sensor());
+  e.state = static_cast<FaultState>(d.state());
+  e.kind = static_cast<FaultKind>(d.kind());
+  e.c_a = d.c_a();
+  e.c_g = d.c_g();
+  e.statistic = d.statistic();
+  e.threshold = d.threshold();
+  e.onset_time = d.onset_time();
+  e.detection_time = d.detection_time();
+  e.sequence = d.sequence();
+  e.A << d.a()[0], d.a()[1], d.a()[2], d.a()[3];
+  e.message = d.message().to_string();
+  *out = e;
+  return true;
+}
+
+fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const IsolationParams& p) {
+  fdi::FdiStatus d;
+  d.mmsi(mmsi);
+  d.stamp(s.stamp);
+  const Mat2& A = s.estimate.A;
+  d.a({A(0, 0), A(0, 1), A(1, 0), A(1, 1)});
+  d.converged(s.estimate.converged);
+  d.armed(s.isolation.armed);
+  d.excitation(s.estimate.excitation);
+  d.sigma_v(s.isolation.sigma_s(0));
+  d.sigma_r(s.isolation.sigma_s(1));
+  d.poles_v({p.poles_v(0), p.poles_v(1)});
+  d.poles_g({p.poles_g(0), p.poles_g(1)});
+  const InputHealth& in = s.isolation.input;
+  d.ins_healthy(!s.ins_silent && in.v_ok && in.r_ok);
+  d.rudder_healthy(in.delta_ok);
+  d.samples(s.samples);
+  d.dropped(s.dropped_inputs + s.dropped_ident + s.dropped_output);
+  std::string msg;
+  if (s.ins_silent) msg += "INS silent; ";
+  if (!in.delta_ok) msg += "rudder missing: identification and isolation paused; ";
+  if (!s.isolation.observer_problem.empty()) msg += s.isolation.observer_problem + "; ";
+  if (!s.isolation.armed) {
+    msg += s.estimate.converged ? "converged, arming; " : "identifying A; ";
+  } else if (s.isolation.learning || s.isolation.settling) {
+    msg += "armed, learning healthy statistics; ";
+  } else {
+    msg += "armed; ";
+  }
+  if (s.rejected > 0) msg += std::to_string(s.rejected) + " samples rejected; ";
+  d.message(msg.substr(0, 127).c_str());
+  return d;
+}
+
+InsInput from_dds(const fdi::InsSample& s) {
+  return InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid()};
+}
+
+RudderInput from_dds(const fdi::RudderSample& s) {
+  return RudderInput{s.stamp(), s.delta(), s.valid()};
+}
+
+AckInput from_dds(const fdi::FaultAck& a) {
+  AckInput out;
+  out.sensor = static_cast<Sensor>(a.sensor());
+  out.sequence = a.sequence();
+  out.who = a.operator_id().to_string();
+  return out;
+}
+
+}  // namespace usvfdi::service

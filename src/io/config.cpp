@@ -1,0 +1,332 @@
+#include "usv_fdi/io/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace usvfdi::io {
+namespace {
+
+/// Short, single-line rendering of a node for error messages.
+std::string render(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "null";
+  if (node.IsScalar()) return "'" + node.Scalar() + "'";
+  YAML::Emitter e;
+  e.SetSeqFormat(YAML::Flow);
+  e.SetMapFormat(YAML::Flow);
+  e << node;
+  std::string s = e.c_str();
+  for (char& c : s) {
+    if (c == '\n') c = ' ';
+  }
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+const char* type_name(const YAML::Node& node) {
+  if (!node.IsDefined() || node.IsNull()) return "null";
+  if (node.IsScalar()) return "a scalar";
+  if (node.IsSequence()) return "a list";
+  return "a mapping";
+}
+
+/// Parses one YAML document into an EngineConfig; every problem names file, key, line, value.
+class Loader {
+ public:
+  explicit Loader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
+                         const std::string& reason) const {
+    std::ostringstream os;
+    os << file_;
+    if (node.IsDefined() && node.Mark().line >= 0) os << ":" << node.Mark().line + 1;
+    os << ": " << (path.empty() ? "(document)" : path) << " = " << render(node) << ": " << reason;
+    throw ConfigError(os.str());
+  }
+
+  [[noreturn]] void fail_missing(const YAML::Node& parent, const std::string& path) const {
+    std::ostringstream os;
+    os << file_;
+    if (parent.IsDefined() && parent.Mark().line >= 0) os << ":" << parent.Mark().line + 1;
+    os << ": " << path << ": required key missing (e.g. `B: [0.165, -2.19]` under `model:`)";
+    throw ConfigError(os.str());
+  }
+
+  double number(const YAML::Node& n, const std::string& path) {
+    remember(n, path);
+    if (!n.IsScalar()) fail(n, path, std::string("expected a number, got ") + type_name(n));
+    double x = 0.0;
+    if (!YAML::convert<double>::decode(n, x)) fail(n, path, "expected a number");
+    return x;
+  }
+
+  int integer(const YAML::Node& n, const std::string& path) {
+    remember(n, path);
+    if (!n.IsScalar()) fail(n, path, std::string("expected an integer, got ") + type_name(n));
+    int x = 0;
+    if (!YAML::convert<int>::decode(n, x)) fail(n, path, "expected an integer");
+    return x;
+  }
+
+  bool boolean(const YAML::Node& n, const std::string& path) {
+    remember(n, path);
+    if (!n.IsScalar()) fail(n, path, std::string("expected true or false, got ") + type_name(n));
+    bool x = false;
+    if (!YAML::convert<bool>::decode(n, x)) fail(n, path, "expected true or false");
+    return x;
+  }
+
+  std::string text(const YAML::Node& n, const std::string& path) {
+    remember(n, path);
+    if (!n.IsScalar()) fail(n, path, std::string("expected a string, got ") + type_name(n));
+    return n.Scalar();
+  }
+
+  template <int N>
+  Eigen::Matrix<double, N, 1> vector(const YAML::Node& n, const std::string& path) {
+    remember(n, path);
+    if (!n.IsSequence() || n.size() != static_cast<std::size_t>(N)) {
+      fail(n, path,
+           "expected a list of " + std::to_string(N) + " numbers, got " +
+               (n.IsSequence() ? "a list of " + std::to_string(n.size())
+                               : std::string(type_name(n))));
+    }
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) v(i) = number(n[i], path + "[" + std::to_string(i) + "]");
+    remember(n, path);  // the element paths must not shadow the list's own mark
+    return v;
+  }
+
+  using Handler = std::function<void(const YAML::Node&, const std::string&)>;
+
+  /// Walks a mapping, dispatching every key to its handler; unknown keys are errors.
+  void section(const YAML::Node& node, const std::string& path,
+               const std::map<std::string, Handler>& handlers) {
+    remember(node, path);
+    if (!node.IsDefined() || node.IsNull()) return;  // `identification:` with nothing under it
+    if (!node.IsMap()) fail(node, path, std::string("expected a mapping, got ") + type_name(node));
+    std::set<std::string> keys;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : render(kv.first);
+      const std::string sub = path.empty() ? key : path + "." + key;
+      if (!keys.insert(key).second) fail(kv.second, sub, "key given twice");
+      const auto it = handlers.find(key);
+      if (it == handlers.end()) {
+        std::string allowed;
+        for (const auto& h : handlers) allowed += (allowed.empty() ? "" : ", ") + h.first;
+        YAML::Node where =
+            kv.second.IsDefined() && kv.second.Mark().line >= 0 ? kv.second : kv.first;
+        fail(where, sub, "unknown key (expected one of: " + allowed + ")");
+      }
+      it->second(kv.second, sub);
+    }
+  }
+
+  EngineConfig load(const YAML::Node& root) {
+    EngineConfig cfg;
+    bool have_b = false;
+    IdentificationParams& id = cfg.identification;
+    IsolationParams& is = cfg.isolation;
+
+    auto num = [this](double* out) {
+      return [this, out](const YAML::Node& n, const std::string& p) { *out = number(n, p); };
+    };
+    auto integ = [this](int* out) {
+      return [this, out](const YAML::Node& n, const std::string& p) { *out = integer(n, p); };
+    };
+    auto boo = [this](bool* out) {
+      return [this, out](const YAML::Node& n, const std::string& p) { *out = boolean(n, p); };
+    };
+    auto vec2 = [this](Vec2* out) {
+      return [this, out](const YAML::Node& n, const std::string& p) { *out = vector<2>(n, p); };
+    };
+
+    const std::map<std::string, Handler> model = {
+        {"B",
+         [&](const YAML::Node& n, const std::string& p) {
+           cfg.B = vector<2>(n, p);
+           have_b = true;
+         }},
+        {"A0",
+         [&](const YAML::Node& n, const std::string& p) {
+           id.a0 = vector<4>(n, p);
+           remember(n, "identification.a0");  // the name validate() uses
+         }},
+    };
+    const std::map<std::string, Handler> identification = {
+        {"method",
+         [&](const YAML::Node& n, const std::string& p) {
+           const std::string m = text(n, p);
+           if (m == "kreisselmeier") {
+             id.method = IdentMethod::kKreisselmeier;
+           } else if (m == "paper") {
+             id.method = IdentMethod::kPaper;
+           } else {
+             fail(n, p, "expected kreisselmeier or paper");
+           }
+         }},
+        {"eps1", num(&id.eps1)},
+        {"eps2", num(&id.eps2)},
+        {"gamma", num(&id.gamma)},
+        {"normalised", boo(&id.normalised)},
+        {"mu", num(&id.mu)},
+        {"lambda", num(&id.lambda)},
+        {"warmup_time", num(&id.warmup_time)},
+        {"max_gap", num(&id.max_gap)},
+        {"curvature_correction", boo(&id.curvature_correction)},
+        {"min_excitation", num(&id.min_excitation)},
+        {"settle_window", num(&id.settle_window)},
+        {"settle_tolerance", num(&id.settle_tolerance)},
+        {"settle_windows", integ(&id.settle_windows)},
+        {"settle_floor", num(&id.settle_floor)},
+        {"delay", num(&cfg.identification_delay)},
+    };
+    const std::map<std::string, Handler> isolation = {
+        {"poles_v", vec2(&is.poles_v)},
+        {"poles_g", vec2(&is.poles_g)},
+        {"min_observability", num(&is.min_observability)},
+        {"redesign_tolerance", num(&is.redesign_tolerance)},
+        {"sigma_v", num(&is.sigma_v)},
+        {"sigma_r", num(&is.sigma_r)},
+        {"sigma_floor_v", num(&is.sigma_floor_v)},
+        {"sigma_floor_r", num(&is.sigma_floor_r)},
+        {"settle_time", num(&is.settle_time)},
+        {"learn_time", num(&is.learn_time)},
+        {"window", num(&is.window)},
+        {"min_window_samples", integ(&is.min_window_samples)},
+        {"clip", num(&is.clip)},
+        {"threshold", num(&is.threshold)},
+        {"threshold_margin", num(&is.threshold_margin)},
+        {"threshold_k", num(&is.threshold_k)},
+        {"exit_ratio", num(&is.exit_ratio)},
+        {"enter_time", num(&is.enter_time)},
+        {"leave_time", num(&is.leave_time)},
+        {"min_active_time", num(&is.min_active_time)},
+        {"c_min", num(&is.c_min)},
+        {"c_margin", num(&is.c_margin)},
+        {"resume_time", num(&is.resume_time)},
+        {"stale_timeout", num(&is.stale_timeout)},
+        {"stuck_time", num(&is.stuck_time)},
+        {"stuck_min_samples", integ(&is.stuck_min_samples)},
+        {"max_abs_v", num(&is.max_abs_v)},
+        {"max_abs_r", num(&is.max_abs_r)},
+        {"max_abs_delta", num(&is.max_abs_delta)},
+        {"spike_gate", num(&is.spike_gate)},
+        {"spike_window", num(&is.spike_window)},
+        {"spike_count", integ(&is.spike_count)},
+        {"invalid_count", integ(&is.invalid_count)},
+        {"classify_window", num(&is.classify_window)},
+    };
+    const auto sub = [this](const std::map<std::string, Handler>& h) {
+      return [this, &h](const YAML::Node& n, const std::string& p) { section(n, p, h); };
+    };
+    const std::map<std::string, Handler> top = {
+        {"model", sub(model)},
+        {"identification", sub(identification)},
+        {"isolation", sub(isolation)},
+        // Parsed by the DDS service; accepted here as any mapping.
+        {"service",
+         [this](const YAML::Node& n, const std::string& p) {
+           remember(n, p);
+           if (n.IsDefined() && !n.IsNull() && !n.IsMap()) {
+             fail(n, p, std::string("expected a mapping, got ") + type_name(n));
+           }
+         }},
+    };
+
+    if (!root.IsDefined() || root.IsNull()) fail_missing(root, "model.B");
+    section(root, "", top);
+    if (!have_b) fail_missing(root["model"].IsDefined() ? root["model"] : root, "model.B");
+
+    try {
+      cfg.validate();
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(locate(e.what()));
+    }
+    return cfg;
+  }
+
+ private:
+  void remember(const YAML::Node& n, const std::string& path) {
+    if (n.IsDefined() && n.Mark().line >= 0) seen_[path] = {n.Mark().line + 1, render(n)};
+  }
+
+  /// A validate() message ("<key.path> = <value>: <reason>") prefixed with "file:line: " and
+  /// followed by the value as written in the file, for the longest key path it starts with.
+  std::string locate(const std::string& message) const {
+    std::string best;
+    const Seen* where = nullptr;
+    for (const auto& [path, seen] : seen_) {
+      if (path.size() > best.size() && message.compare(0, path.size(), path) == 0) {
+        const char next = message.size() > path.size() ? message[path.size()] : ' ';
+        if (next == ' ' || next == '=' || next == ':') {
+          best = path;
+          where = &seen;
+        }
+      }
+    }
+    if (where == nullptr) return file_ + ": " + message + " (default value)";
+    std::string m = message;
+    if (best == "identification.a0") m = "model.A0" + m.substr(best.size());  // its YAML key
+    return file_ + ":" + std::to_string(where->line) + ": " + m + " (in the file: " + where->text +
+           ")";
+  }
+
+  struct Seen {
+    int line = 0;      ///< 1-based
+    std::string text;  ///< the value as written
+  };
+  std::string file_;
+  std::map<std::string, Seen> seen_;
+};
+
+EngineConfig load_node(const std::string& name, const std::function<YAML::Node()>& parse) {
+  YAML::Node root;
+  try {
+    root = parse();
+  } catch (const YAML::ParserException& e) {
+    std::ostringstream os;
+    os << name;
+    if (e.mark.line >= 0) os << ":" << e.mark.line + 1 << ":" << e.mark.column + 1;
+    os << ": YAML syntax error: " << e.msg;
+    throw ConfigError(os.str());
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(name + ": " + e.what());
+  }
+  try {
+    return Loader(name).load(root);
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const YAML::Exception& e) {  // defensive: a yaml-cpp surprise still names the file
+    throw ConfigError(name + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+EngineConfig load_engine_config(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw ConfigError(path + ": no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) throw ConfigError(path + ": not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ": cannot open for reading: " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return load_engine_config_from_string(text.str(), path);
+}
+
+EngineConfig load_engine_config_from_string(const std::string& yaml, const std::string& name) {
+  return load_node(name, [&yaml] { return YAML::Load(yaml); });
+}
+
+}  // namespace usvfdi::io

@@ -1,0 +1,141 @@
+#include "usv_fdi/io/jsonl.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+namespace usvfdi::io {
+namespace {
+
+/// Length of the valid UTF-8 sequence starting at s[i], or 0 when it is not valid.
+std::size_t utf8_length(const std::string& s, std::size_t i) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = b(i);
+  std::size_t n = 0;
+  unsigned cp = 0;
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+    cp = c & 0x1Fu;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    cp = c & 0x0Fu;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    cp = c & 0x07u;
+  } else {
+    return 0;
+  }
+  if (i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k) {
+    if ((b(i + k) & 0xC0u) != 0x80u) return 0;
+    cp = (cp << 6) | (b(i + k) & 0x3Fu);
+  }
+  if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF))) return 0;
+  if (cp >= 0xD800 && cp <= 0xDFFF) return 0;  // surrogates are not characters
+  return n;
+}
+
+std::string array4(const Vec4& a) {
+  return "[" + json_number(a(0)) + "," + json_number(a(1)) + "," + json_number(a(2)) + "," +
+         json_number(a(3)) + "]";
+}
+
+const char* boolean(bool b) { return b ? "true" : "false"; }
+
+}  // namespace
+
+std::string json_string(const std::string& s) {
+  std::string o;
+  o.reserve(s.size() + 2);
+  o += '"';
+  for (std::size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      switch (c) {
+        case '"':
+          o += "\\\"";
+          break;
+        case '\\':
+          o += "\\\\";
+          break;
+        case '\b':
+          o += "\\b";
+          break;
+        case '\f':
+          o += "\\f";
+          break;
+        case '\n':
+          o += "\\n";
+          break;
+        case '\r':
+          o += "\\r";
+          break;
+        case '\t':
+          o += "\\t";
+          break;
+        default:
+          if (c < 0x20 || c == 0x7F) {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\u%04x", c);
+            o += buf;
+          } else {
+            o += static_cast<char>(c);
+          }
+      }
+      ++i;
+      continue;
+    }
+    const std::size_t n = utf8_length(s, i);
+    if (n == 0) {
+      o += "\\ufffd";
+      ++i;
+    } else {
+      o.append(s, i, n);
+      i += n;
+    }
+  }
+  o += '"';
+  return o;
+}
+
+std::string json_number(double x) {
+  if (!std::isfinite(x)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", x);
+  return buf;
+}
+
+void JsonlWriter::event(const FaultEvent& e) {
+  out_ << "{\"type\":\"event\",\"t\":" << json_number(e.t)
+       << ",\"sensor\":" << json_string(to_string(e.sensor))
+       << ",\"state\":" << json_string(to_string(e.state))
+       << ",\"kind\":" << json_string(to_string(e.kind)) << ",\"c_a\":" << json_number(e.c_a)
+       << ",\"c_g\":" << json_number(e.c_g) << ",\"statistic\":" << json_number(e.statistic)
+       << ",\"threshold\":" << json_number(e.threshold)
+       << ",\"onset_time\":" << json_number(e.onset_time)
+       << ",\"detection_time\":" << json_number(e.detection_time) << ",\"sequence\":" << e.sequence
+       << ",\"a\":" << array4(to_params(e.A)) << ",\"message\":" << json_string(e.message) << "}\n";
+}
+
+void JsonlWriter::estimate(double t, const Estimate& est, bool armed) {
+  out_ << "{\"type\":\"estimate\",\"t\":" << json_number(t) << ",\"a\":" << array4(to_params(est.A))
+       << ",\"converged\":" << boolean(est.converged)
+       << ",\"excitation\":" << json_number(est.excitation) << ",\"armed\":" << boolean(armed)
+       << "}\n";
+}
+
+void JsonlWriter::summary(const RunSummary& s) {
+  out_ << "{\"type\":\"summary\",\"samples\":" << s.samples << ",\"rejected\":" << s.rejected
+       << ",\"events\":" << s.events << ",\"raised\":{\"accelerometer\":" << s.raised[0]
+       << ",\"gyro\":" << s.raised[1] << ",\"unknown\":" << s.raised[2]
+       << "},\"final_a\":" << array4(s.final_a) << ",\"converged\":" << boolean(s.converged)
+       << ",\"frozen_samples\":" << s.frozen_samples
+       << ",\"duration_s\":" << json_number(s.duration_s)
+       << ",\"complete\":" << boolean(s.complete);
+  if (!s.complete) out_ << ",\"error\":" << json_string(s.error);
+  out_ << "}\n";
+}
+
+void JsonlWriter::flush() { out_.flush(); }
+
+}  // namespace usvfdi::io

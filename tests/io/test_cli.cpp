@@ -1,0 +1,230 @@
+// End-to-end tests of the usv-fdi executable: sim -> CSV -> replay -> JSON Lines, exit
+// codes and messages on bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "json_lite.hpp"
+
+namespace usvfdi::io {
+namespace {
+
+namespace js = usvfdi::testing_json;
+const std::string kExe = USV_FDI_EXE;
+const std::string kSource = USV_FDI_SOURCE_DIR;
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
+}
+
+void spit(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = ::testing::TempDir() + "usv_fdi_cli_" + info->name() + "_" + std::to_string(::getpid()) +
+           "/";
+    ASSERT_EQ(std::system(("mkdir -p '" + dir_ + "'").c_str()), 0);
+  }
+  void TearDown() override {
+    if (!HasFailure()) std::system(("rm -rf '" + dir_ + "'").c_str());
+  }
+
+  std::string path(const std::string& name) const { return dir_ + name; }
+
+  Outcome run(const std::string& args) const {
+    Outcome r;
+    const std::string out = path("stdout.txt"), err = path("stderr.txt");
+    const std::string cmd = "'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'";
+    const int status = std::system(cmd.c_str());
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  /// A short simulated CSV (paper scenario on the Otter, 10 Hz, 30 s).
+  std::string small_csv() const {
+    const std::string csv = path("small.csv");
+    const Outcome r =
+        run("sim --vessel otter --scenario paper --rate 10 --duration 30 --output '" + csv + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return csv;
+  }
+
+  std::string dir_;
+};
+
+std::vector<js::Value> parse_lines(const std::string& text) {
+  std::vector<js::Value> out;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    EXPECT_FALSE(line.empty());
+    out.push_back(js::parse(line));  // throws on anything that is not one JSON value
+    EXPECT_EQ(out.back().kind, js::Value::kObject) << line;
+  }
+  return out;
+}
+
+bool has(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+TEST_F(Cli, SimThenReplayWritesWellFormedRecords) {
+  const std::string csv = small_csv();
+  const std::string text = slurp(csv);
+  EXPECT_EQ(text.rfind("t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g\n", 0),
+            0u);
+  EXPECT_TRUE(has(text, ",bias\n")) << "the gyro bias of the paper scenario from t = 20 s";
+
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  // to a file
+  const std::string jsonl = path("out.jsonl");
+  Outcome r = run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + jsonl + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto recs = parse_lines(slurp(jsonl));
+  // and to stdout: the same bytes
+  Outcome s = run("replay --config '" + cfg + "' --input '" + csv + "'");
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_EQ(s.out, slurp(jsonl));
+
+  ASSERT_GE(recs.size(), 31u);  // >= one estimate per second of data, plus the summary
+  int estimates = 0;
+  for (const js::Value& v : recs) {
+    const std::string type = v.at("type").str;
+    if (type == "estimate") {
+      ++estimates;
+      EXPECT_EQ(v.at("a").arr.size(), 4u);
+      EXPECT_EQ(v.at("converged").kind, js::Value::kBool);
+    } else if (type == "event") {
+      for (const char* k : {"t", "sensor", "state", "kind", "c_a", "c_g", "statistic", "threshold",
+                            "onset_time", "detection_time", "sequence", "a", "message"}) {
+        EXPECT_TRUE(v.has(k)) << k;
+      }
+    } else {
+      EXPECT_EQ(type, "summary");
+    }
+  }
+  EXPECT_GE(estimates, 30);
+  const js::Value& sum = recs.back();
+  EXPECT_EQ(sum.at("type").str, "summary");
+  EXPECT_EQ(sum.at("samples").num, 301.0);
+  EXPECT_EQ(sum.at("duration_s").num, 30.0);
+  EXPECT_TRUE(sum.at("complete").b);
+}
+
+TEST_F(Cli, ConfigErrorsExitWith2AndNameFileKeyAndValue) {
+  const std::string csv = small_csv();
+  Outcome r = run("replay --config '" + path("missing.yaml") + "' --input '" + csv + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(has(r.err, "missing.yaml")) << r.err;
+  EXPECT_TRUE(r.out.empty());
+
+  spit(path("bad.yaml"), "model:\n  B: [1, 2]\nisolation:\n  poles_v: [-1, -2, -3]\n");
+  r = run("replay --config '" + path("bad.yaml") + "' --input '" + csv + "'");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(has(r.err, "bad.yaml:4")) << r.err;
+  EXPECT_TRUE(has(r.err, "isolation.poles_v")) << r.err;
+  EXPECT_TRUE(has(r.err, "[-1, -2, -3]")) << r.err;
+}
+
+TEST_F(Cli, InputErrorsExitWith3AndKeepTheRecordsBefore) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  Outcome r = run("replay --config '" + cfg + "' --input '" + path("none.csv") + "'");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "none.csv")) << r.err;
+
+  spit(path("nocol.csv"), "t,v,r\n0,0,0\n");
+  r = run("replay --config '" + cfg + "' --input '" + path("nocol.csv") + "'");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "nocol.csv:1")) << r.err;
+  EXPECT_TRUE(has(r.err, "'delta'")) << r.err;
+
+  // A bad number on line 203 (t = 20.1 s) of an otherwise good file.
+  std::istringstream in(slurp(small_csv()));
+  std::string line, text;
+  for (int n = 1; std::getline(in, line); ++n)
+    text += (n == 203 ? "20.1,0.01,1.2.3,0,0,0,0,0,0,," : line) + "\n";
+  spit(path("bad.csv"), text);
+  const std::string jsonl = path("bad.jsonl");
+  r = run("replay --config '" + cfg + "' --input '" + path("bad.csv") + "' --output '" + jsonl +
+          "'");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "bad.csv:203")) << r.err;
+  EXPECT_TRUE(has(r.err, "'r'")) << r.err;
+  EXPECT_TRUE(has(r.err, "1.2.3")) << r.err;
+  const auto recs = parse_lines(slurp(jsonl));
+  ASSERT_GE(recs.size(), 20u);  // the estimates of the first 20 s are there
+  EXPECT_EQ(recs.back().at("type").str, "summary");
+  EXPECT_FALSE(recs.back().at("complete").b);
+  EXPECT_EQ(recs.back().at("samples").num, 201.0);
+  EXPECT_TRUE(has(recs.back().at("error").str, "bad.csv:203"));
+}
+
+TEST_F(Cli, SimFaultsAndOptions) {
+  const std::string csv = path("f.csv");
+  Outcome r =
+      run("sim --vessel mariner --scenario healthy --rate 5 --duration 12 --seed 4 "
+          "--steering sine --noise-scale 0 --fault gyro:stuck:2:4 "
+          "--fault accelerometer:bias:6:8:0.1 --output '" +
+          csv + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "gyro:stuck:2:4")) << r.err;
+  std::istringstream in(slurp(csv));
+  std::string line;
+  std::getline(in, line);
+  int rows = 0, stuck = 0, bias = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    if (has(line, ",,stuck")) ++stuck;
+    if (has(line, ",bias,")) ++bias;
+  }
+  EXPECT_EQ(rows, 61);
+  EXPECT_EQ(stuck, 10);
+  EXPECT_EQ(bias, 10);
+
+  r = run("sim --fault gyro:wobble:1:2:3 --output '" + csv + "'");
+  EXPECT_EQ(r.code, 64);
+  EXPECT_TRUE(has(r.err, "gyro:wobble:1:2:3")) << r.err;
+  r = run("sim --vessel titanic --output '" + csv + "'");
+  EXPECT_EQ(r.code, 64);
+  EXPECT_TRUE(has(r.err, "titanic")) << r.err;
+}
+
+TEST_F(Cli, VesselsListsTheShippedModels) {
+  const Outcome r = run("vessels");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "mariner")) << r.out;
+  EXPECT_TRUE(has(r.out, "otter")) << r.out;
+  EXPECT_TRUE(has(r.out, "B:")) << r.out;
+  EXPECT_TRUE(has(r.out, "Fossen")) << r.out;
+}
+
+TEST_F(Cli, UsageErrors) {
+  EXPECT_EQ(run("").code, 64);
+  EXPECT_EQ(run("frobnicate").code, 64);
+  EXPECT_EQ(run("replay --input x.csv").code, 64);
+  EXPECT_EQ(run("--help").code, 0);
+}
+
+}  // namespace
+}  // namespace usvfdi::io

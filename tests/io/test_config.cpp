@@ -1,0 +1,269 @@
+// YAML configuration loader: defaults, shipped files, and every kind of error message.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "usv_fdi/core/vessel.hpp"
+#include "usv_fdi/io/config.hpp"
+
+namespace usvfdi::io {
+namespace {
+
+const std::string kSource = USV_FDI_SOURCE_DIR;
+
+/// The ConfigError message of loading `yaml` as "cfg_test.yaml" (fails the test if none).
+std::string error_of(const std::string& yaml) {
+  try {
+    load_engine_config_from_string(yaml, "cfg_test.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not a ConfigError: " << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for:\n" << yaml;
+  return "";
+}
+
+#define EXPECT_MENTIONS(message, ...)                       \
+  for (const char* part : {__VA_ARGS__}) {                  \
+    EXPECT_NE((message).find(part), std::string::npos)      \
+        << "message lacks '" << part << "': " << (message); \
+  }
+
+void expect_same(const EngineConfig& a, const EngineConfig& b) {
+  EXPECT_EQ(a.B, b.B);
+  EXPECT_EQ(a.identification_delay, b.identification_delay);
+  const IdentificationParams &x = a.identification, &y = b.identification;
+  EXPECT_EQ(x.method, y.method);
+  EXPECT_EQ(x.eps1, y.eps1);
+  EXPECT_EQ(x.eps2, y.eps2);
+  EXPECT_EQ(x.gamma, y.gamma);
+  EXPECT_EQ(x.normalised, y.normalised);
+  EXPECT_EQ(x.mu, y.mu);
+  EXPECT_EQ(x.lambda, y.lambda);
+  EXPECT_EQ(x.warmup_time, y.warmup_time);
+  EXPECT_EQ(x.max_gap, y.max_gap);
+  EXPECT_EQ(x.curvature_correction, y.curvature_correction);
+  EXPECT_EQ(x.a0, y.a0);
+  EXPECT_EQ(x.min_excitation, y.min_excitation);
+  EXPECT_EQ(x.settle_window, y.settle_window);
+  EXPECT_EQ(x.settle_tolerance, y.settle_tolerance);
+  EXPECT_EQ(x.settle_windows, y.settle_windows);
+  EXPECT_EQ(x.settle_floor, y.settle_floor);
+  const IsolationParams &p = a.isolation, &q = b.isolation;
+  EXPECT_EQ(p.poles_v, q.poles_v);
+  EXPECT_EQ(p.poles_g, q.poles_g);
+  EXPECT_EQ(p.min_observability, q.min_observability);
+  EXPECT_EQ(p.redesign_tolerance, q.redesign_tolerance);
+  EXPECT_EQ(p.sigma_v, q.sigma_v);
+  EXPECT_EQ(p.sigma_r, q.sigma_r);
+  EXPECT_EQ(p.sigma_floor_v, q.sigma_floor_v);
+  EXPECT_EQ(p.sigma_floor_r, q.sigma_floor_r);
+  EXPECT_EQ(p.settle_time, q.settle_time);
+  EXPECT_EQ(p.learn_time, q.learn_time);
+  EXPECT_EQ(p.window, q.window);
+  EXPECT_EQ(p.min_window_samples, q.min_window_samples);
+  EXPECT_EQ(p.clip, q.clip);
+  EXPECT_EQ(p.threshold, q.threshold);
+  EXPECT_EQ(p.threshold_margin, q.threshold_margin);
+  EXPECT_EQ(p.threshold_k, q.threshold_k);
+  EXPECT_EQ(p.exit_ratio, q.exit_ratio);
+  EXPECT_EQ(p.enter_time, q.enter_time);
+  EXPECT_EQ(p.leave_time, q.leave_time);
+  EXPECT_EQ(p.min_active_time, q.min_active_time);
+  EXPECT_EQ(p.c_min, q.c_min);
+  EXPECT_EQ(p.c_margin, q.c_margin);
+  EXPECT_EQ(p.resume_time, q.resume_time);
+  EXPECT_EQ(p.stale_timeout, q.stale_timeout);
+  EXPECT_EQ(p.stuck_time, q.stuck_time);
+  EXPECT_EQ(p.stuck_min_samples, q.stuck_min_samples);
+  EXPECT_EQ(p.max_abs_v, q.max_abs_v);
+  EXPECT_EQ(p.max_abs_r, q.max_abs_r);
+  EXPECT_EQ(p.max_abs_delta, q.max_abs_delta);
+  EXPECT_EQ(p.spike_gate, q.spike_gate);
+  EXPECT_EQ(p.spike_window, q.spike_window);
+  EXPECT_EQ(p.spike_count, q.spike_count);
+  EXPECT_EQ(p.invalid_count, q.invalid_count);
+  EXPECT_EQ(p.classify_window, q.classify_window);
+}
+
+TEST(Config, OnlyModelBGivesTheCoreDefaults) {
+  const EngineConfig c = load_engine_config_from_string("model:\n  B: [0.5, -2]\n");
+  EngineConfig want;
+  want.B = Vec2(0.5, -2.0);
+  expect_same(c, want);
+}
+
+TEST(Config, DefaultYamlStatesExactlyTheCoreDefaults) {
+  // config/default.yaml documents every key with its default: it must not drift.
+  const EngineConfig c = load_engine_config(kSource + "/config/default.yaml");
+  EngineConfig want;
+  want.B = c.B;
+  expect_same(c, want);
+}
+
+TEST(Config, ShippedVesselConfigsMatchTheVesselModels) {
+  for (const VesselModel& v : shipped_vessels()) {
+    SCOPED_TRACE(v.name);
+    const EngineConfig c = load_engine_config(kSource + "/config/vessels/" + v.name + ".yaml");
+    EXPECT_EQ(c.B, v.B);
+    EXPECT_EQ(c.isolation.sigma_v, v.sigma_v);
+    EXPECT_EQ(c.isolation.sigma_r, v.sigma_r);
+  }
+}
+
+TEST(Config, PaperYamlSelectsThePapersEstimator) {
+  const EngineConfig c = load_engine_config(kSource + "/config/paper.yaml");
+  EXPECT_EQ(c.identification.method, IdentMethod::kPaper);
+  EXPECT_EQ(c.identification.eps1, 100.0);
+  EXPECT_EQ(c.identification.eps2, 200.0);
+  EXPECT_EQ(c.identification.gamma, 1.0);
+  EXPECT_FALSE(c.identification.normalised);
+}
+
+TEST(Config, EveryKeyIsRead) {
+  const EngineConfig c = load_engine_config_from_string(R"(
+model: {B: [1, 2], A0: [-1, -2, -3, -4]}
+identification:
+  method: paper
+  eps1: 3
+  eps2: 4
+  gamma: 5
+  normalised: false
+  mu: 1e-10
+  lambda: 0.2
+  warmup_time: 7
+  max_gap: 2
+  curvature_correction: false
+  min_excitation: 0.5
+  settle_window: 2
+  settle_tolerance: 0.02
+  settle_windows: 4
+  settle_floor: 0.001
+  delay: 0.25
+isolation:
+  poles_v: [-1, -2]
+  poles_g: [-3, -4]
+  sigma_v: 0.01
+  sigma_r: 0.001
+  stuck_min_samples: 7
+  spike_count: 5
+  classify_window: 9
+service:
+  domain_id: 7
+  mmsi: 257000000
+  topics: {ins: usv/ins, rudder: usv/rudder}
+  partitions: [fleet]
+)");
+  EXPECT_EQ(c.identification.a0, Vec4(-1, -2, -3, -4));
+  EXPECT_EQ(c.identification.method, IdentMethod::kPaper);
+  EXPECT_EQ(c.identification.eps2, 4.0);
+  EXPECT_EQ(c.identification.mu, 1e-10);
+  EXPECT_FALSE(c.identification.curvature_correction);
+  EXPECT_EQ(c.identification.settle_windows, 4);
+  EXPECT_EQ(c.identification_delay, 0.25);
+  EXPECT_EQ(c.isolation.poles_g, Vec2(-3, -4));
+  EXPECT_EQ(c.isolation.stuck_min_samples, 7);
+  EXPECT_EQ(c.isolation.classify_window, 9.0);
+}
+
+TEST(ConfigError, UnknownKeyNamesFileKeyLineAndValue) {
+  const std::string m = error_of("model:\n  B: [1, 2]\nisolation:\n  polesv: [-1, -2]\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:4", "isolation.polesv", "[-1, -2]", "unknown key");
+}
+
+TEST(ConfigError, UnknownTopLevelKey) {
+  const std::string m = error_of("model:\n  B: [1, 2]\nisolaton:\n  window: 1\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:4", "isolaton", "unknown key");
+}
+
+TEST(ConfigError, WrongTypeNamesFileKeyLineAndValue) {
+  const std::string m = error_of("model:\n  B: [1, 2]\nidentification:\n  eps1: fast\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:4", "identification.eps1", "'fast'", "number");
+  const std::string n = error_of("model:\n  B: [1, 2]\nisolation:\n  spike_count: 2.5\n");
+  EXPECT_MENTIONS(n, "cfg_test.yaml:4", "isolation.spike_count", "2.5", "integer");
+  const std::string b = error_of("model:\n  B: [1, 2]\nidentification:\n  normalised: 3\n");
+  EXPECT_MENTIONS(b, "cfg_test.yaml:4", "identification.normalised", "3");
+  const std::string s = error_of("model:\n  B: [1, 2]\nisolation: 5\n");
+  EXPECT_MENTIONS(s, "cfg_test.yaml:3", "isolation", "'5'", "mapping");
+  const std::string e = error_of("model:\n  B: [1, x]\n");
+  EXPECT_MENTIONS(e, "cfg_test.yaml:2", "model.B[1]", "'x'");
+}
+
+TEST(ConfigError, WrongListLengthNamesFileKeyLineAndValue) {
+  const std::string m = error_of("model:\n  B: [1, 2]\nisolation:\n  poles_v: [-1, -2, -3]\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:4", "isolation.poles_v", "[-1, -2, -3]", "2 numbers");
+  const std::string a = error_of("model:\n  B: [1, 2]\n  A0: [1, 2]\n");
+  EXPECT_MENTIONS(a, "cfg_test.yaml:3", "model.A0", "[1, 2]", "4 numbers");
+  const std::string s = error_of("model:\n  B: 3\n");
+  EXPECT_MENTIONS(s, "cfg_test.yaml:2", "model.B", "'3'");
+}
+
+TEST(ConfigError, MissingModelB) {
+  const std::string m = error_of("identification:\n  eps1: 2\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml", "model.B", "required");
+  EXPECT_MENTIONS(error_of(""), "cfg_test.yaml", "model.B", "required");
+}
+
+TEST(ConfigError, MissingFileNamesTheFile) {
+  try {
+    load_engine_config("/nonexistent/dir/engine.yaml");
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/engine.yaml"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ConfigError, SyntaxErrorNamesFileAndLine) {
+  const std::string m = error_of("model:\n  B: [1, 2\nisolation:\n  window: 1\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:", "syntax");
+  const std::string n = error_of("model:\n  B: [1, 2]\n   bad_indent: 1\n  - x\n");
+  EXPECT_MENTIONS(n, "cfg_test.yaml:");
+}
+
+TEST(ConfigError, ValidateFailureIsRethrownWithFileKeyLineAndValue) {
+  const std::string m = error_of("model:\n  B: [1, 2]\nidentification:\n  eps1: -3\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:4", "identification.eps1", "-3", "positive");
+  const std::string b = error_of("# B must not vanish\nmodel:\n  B: [0, 0]\n");
+  EXPECT_MENTIONS(b, "cfg_test.yaml:3", "model.B", "[0, 0]");
+  const std::string p = error_of("model:\n  B: [1, 2]\nisolation:\n  poles_g: [-1, 0.5]\n");
+  EXPECT_MENTIONS(p, "cfg_test.yaml:4", "isolation.poles_g", "[-1, 0.5]", "negative");
+  const std::string d = error_of("model:\n  B: [1, 2]\nidentification:\n  delay: -1\n");
+  EXPECT_MENTIONS(d, "cfg_test.yaml:4", "identification.delay", "-1");
+  const std::string a = error_of("model:\n  B: [1, 2]\n  A0: [1, 2, 3, .nan]\n");
+  EXPECT_MENTIONS(a, "cfg_test.yaml:3", "model.A0", ".nan");
+}
+
+TEST(ConfigError, DuplicateKey) {
+  const std::string m = error_of("model:\n  B: [1, 2]\n  B: [3, 4]\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:3", "model.B", "twice");
+}
+
+TEST(ConfigError, ServiceSectionMustBeAMapping) {
+  EXPECT_NO_THROW(load_engine_config_from_string("model: {B: [1, 2]}\nservice:\n  anything: 1\n"));
+  EXPECT_NO_THROW(load_engine_config_from_string("model: {B: [1, 2]}\nservice:\n"));
+  const std::string m = error_of("model: {B: [1, 2]}\nservice: [1, 2]\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:2", "service", "mapping");
+}
+
+TEST(ConfigError, FileErrorsNameThePath) {
+  const std::string path = ::testing::TempDir() + "usv_fdi_cfg_error.yaml";
+  {
+    std::ofstream f(path);
+    f << "model:\n  B: [1, 2]\nisolation:\n  window: soon\n";
+  }
+  try {
+    load_engine_config(path);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    const std::string where = path + ":4";
+    EXPECT_MENTIONS(m, where.c_str(), "isolation.window", "soon");
+  }
+}
+
+}  // namespace
+}  // namespace usvfdi::io
