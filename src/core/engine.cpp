@@ -8,8 +8,8 @@ namespace usvfdi {
 
 void EngineConfig::validate() const {
   if (!B.allFinite() || B.isZero(0.0)) {
-    throw std::invalid_argument("model.B = [" + std::to_string(B(0)) + ", " +
-                                std::to_string(B(1)) + "]: must be finite and non-zero");
+    throw std::invalid_argument("model.B = [" + std::to_string(B(0)) + ", " + std::to_string(B(1)) +
+                                "]: must be finite and non-zero");
   }
   if (!(identification_delay >= 0) || !std::isfinite(identification_delay)) {
     throw std::invalid_argument("identification.delay = " + std::to_string(identification_delay) +

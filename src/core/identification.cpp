@@ -17,8 +17,7 @@ void require(bool ok, const char* field, double value, const char* what) {
 }
 
 bool finite(const Sample& s) {
-  return std::isfinite(s.t) && std::isfinite(s.v) && std::isfinite(s.r) &&
-         std::isfinite(s.delta);
+  return std::isfinite(s.t) && std::isfinite(s.v) && std::isfinite(s.r) && std::isfinite(s.delta);
 }
 
 }  // namespace
@@ -47,8 +46,7 @@ Identifier::Identifier(const IdentificationParams& params, const Vec2& B)
     : p_(params), B_(B), f1_(params.eps1), f2_(params.eps2), a_(params.a0), a_ref_(params.a0) {
   p_.validate();
   if (!B.allFinite()) throw std::invalid_argument("model.B must be finite");
-  const double eps_min =
-      p_.method == IdentMethod::kPaper ? std::min(p_.eps1, p_.eps2) : p_.eps1;
+  const double eps_min = p_.method == IdentMethod::kPaper ? std::min(p_.eps1, p_.eps2) : p_.eps1;
   warmup_ = p_.warmup_time >= 0 ? p_.warmup_time : 10.0 / eps_min;
   est_.A = from_params(a_);
   est_.time_constant = std::numeric_limits<double>::infinity();
@@ -167,9 +165,8 @@ void Identifier::update_convergence(double t) {
     d = std::max(d, std::abs(a_(n) - a_ref_(n)) / (std::abs(a_(n)) + p_.settle_floor));
   }
   est_.settling = d;
-  const bool excited =
-      est_.excitation >= p_.min_excitation &&
-      est_.time_constant <= p_.settle_window * p_.settle_windows;
+  const bool excited = est_.excitation >= p_.min_excitation &&
+                       est_.time_constant <= p_.settle_window * p_.settle_windows;
   settled_count_ = (d < p_.settle_tolerance && excited) ? settled_count_ + 1 : 0;
   if (settled_count_ >= p_.settle_windows) est_.converged = true;
   t_ref_ = t;

@@ -9,8 +9,8 @@ namespace {
 
 void require(bool ok, const char* field, double value, const char* what) {
   if (!ok) {
-    throw std::invalid_argument(std::string("isolation.") + field + " = " +
-                                std::to_string(value) + ": " + what);
+    throw std::invalid_argument(std::string("isolation.") + field + " = " + std::to_string(value) +
+                                ": " + what);
   }
 }
 
@@ -228,8 +228,8 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   if (st_.armed) residual_checks(s, dt, out);
 
   // Freeze identification while anything is suspect, and for resume_time after.
-  bool suspect = !st_.input.v_ok || !st_.input.r_ok || !st_.input.delta_ok ||
-                 !std::isfinite(s.v) || !std::isfinite(s.r) || !std::isfinite(s.delta);
+  bool suspect = !st_.input.v_ok || !st_.input.r_ok || !st_.input.delta_ok || !std::isfinite(s.v) ||
+                 !std::isfinite(s.r) || !std::isfinite(s.delta);
   for (const Condition& c : cond_) suspect = suspect || c.active;
   if (st_.armed && !st_.learning && !st_.settling) {
     suspect = suspect || st_.J.maxCoeff() > p_.exit_ratio * st_.threshold ||
@@ -270,8 +270,8 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
       ch.last_valid_t = s.t;
     }
     const bool stale = s.t - ch.last_valid_t > p_.stale_timeout;
-    const bool stuck = ch.stuck_samples + 1 >= p_.stuck_min_samples &&
-                       s.t - ch.stuck_since >= p_.stuck_time;
+    const bool stuck =
+        ch.stuck_samples + 1 >= p_.stuck_min_samples && s.t - ch.stuck_since >= p_.stuck_time;
     const bool invalid = static_cast<int>(ch.invalids.size()) >= p_.invalid_count;
     ok[c] = !stale && !invalid;
     if (c == 2) continue;  // the rudder is not an INS sensor: it pauses FDI (status flag)
@@ -327,8 +327,8 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       settle_until_ = s.t + settle_time_;
     } else {
       const double d = usable(prev_.delta, p_.max_abs_delta) ? prev_.delta
-                       : std::isfinite(last_delta_)         ? last_delta_
-                                                            : 0.0;
+                       : std::isfinite(last_delta_)          ? last_delta_
+                                                             : 0.0;
       // While a sensor is faulty, its dedicated observer is driven by the other observer's
       // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
       // the fault stays fully visible and the residual is clean the moment the fault ends.
@@ -488,12 +488,11 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
         const Sensor sensor = static_cast<Sensor>(k);
         const FaultKind kind = k < 2 ? classify(k) : FaultKind::kUnknown;
         if (k < 2) refine_at_[k] = s.t + 0.5 * p_.classify_window;
-        std::string msg = k < 2 ? std::string("residual of the ") +
-                                      (k == 0 ? "accelerometer" : "gyro") + " channel: J_N " +
-                                      std::to_string(st_.J(k)) + " > " + std::to_string(thr)
-                                : "residual on both channels, not isolated: J_N " +
-                                      std::to_string(st_.J.maxCoeff()) + " > " +
-                                      std::to_string(thr);
+        std::string msg =
+            k < 2 ? std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
+                        " channel: J_N " + std::to_string(st_.J(k)) + " > " + std::to_string(thr)
+                  : "residual on both channels, not isolated: J_N " +
+                        std::to_string(st_.J.maxCoeff()) + " > " + std::to_string(thr);
         set_condition(sensor, kResidual, true, kind, s.t, msg, out);
         raised_at_[k] = s.t;
         above_since_[k] = kNaN;
@@ -534,8 +533,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       if (s.t - below_since_[k] + eps_t >= p_.leave_time &&
           s.t - raised_at_[k] + eps_t >= p_.min_active_time) {
         set_condition(static_cast<Sensor>(k), kResidual, false, cond_[k].kind, s.t,
-                      "residual back below " + std::to_string(k < 2 ? thr_exit_d : thr_exit),
-                      out);
+                      "residual back below " + std::to_string(k < 2 ? thr_exit_d : thr_exit), out);
         below_since_[k] = kNaN;
       }
     } else {

@@ -4,10 +4,14 @@ namespace usvfdi {
 
 const char* to_string(AckResult r) {
   switch (r) {
-    case AckResult::kAccepted: return "accepted";
-    case AckResult::kStaleSequence: return "stale sequence";
-    case AckResult::kUnknownSequence: return "unknown sequence";
-    case AckResult::kNothingToAck: return "nothing to acknowledge";
+    case AckResult::kAccepted:
+      return "accepted";
+    case AckResult::kStaleSequence:
+      return "stale sequence";
+    case AckResult::kUnknownSequence:
+      return "unknown sequence";
+    case AckResult::kNothingToAck:
+      return "nothing to acknowledge";
   }
   return "?";
 }

@@ -23,8 +23,8 @@ ObserverDesign place_poles(const Mat2& A, int channel, double p1, double p2, dou
   if (!(d.observability >= min_observability)) {
     d.reason = std::string(channel == kV ? "observer V: (A, [1 0]) near-unobservable, a2"
                                          : "observer G: (A, [0 1]) near-unobservable, a3") +
-               " = " + std::to_string(channel == kV ? A(0, 1) : A(1, 0)) +
-               ", index " + std::to_string(d.observability);
+               " = " + std::to_string(channel == kV ? A(0, 1) : A(1, 0)) + ", index " +
+               std::to_string(d.observability);
     return d;
   }
   // Ackermann: k = phi(A) O^{-1} e2, O = [c^T; c^T A], phi(s) = (s - p1)(s - p2).

@@ -46,8 +46,8 @@ Simulator::State Simulator::deriv(const State& z, double delta_c) const {
   State d;
   d.head<2>() = m.A * z.head<2>() + m.B * z(3);
   d(2) = z(1);
-  d(3) = std::clamp((delta_c - z(3)) / m.rudder_time_constant, -m.max_rudder_rate,
-                    m.max_rudder_rate);
+  d(3) =
+      std::clamp((delta_c - z(3)) / m.rudder_time_constant, -m.max_rudder_rate, m.max_rudder_rate);
   return d;
 }
 
@@ -65,20 +65,33 @@ double Simulator::apply_faults(int channel, double t, double truth, double noisy
     *active = f.kind;
     const double dt = 1.0 / c_.rate_hz;
     switch (f.kind) {
-      case FaultKind::kBias: y += f.magnitude; break;
-      case FaultKind::kDrift: y += f.magnitude * (t - f.t_start); break;
-      case FaultKind::kNoise: y += f.magnitude * n01_(rng_); break;
+      case FaultKind::kBias:
+        y += f.magnitude;
+        break;
+      case FaultKind::kDrift:
+        y += f.magnitude * (t - f.t_start);
+        break;
+      case FaultKind::kNoise:
+        y += f.magnitude * n01_(rng_);
+        break;
       case FaultKind::kSpikes:
         if (u01_(rng_) < f.spike_rate * dt) y += (u01_(rng_) < 0.5 ? -1 : 1) * f.magnitude;
         break;
-      case FaultKind::kScale: y += f.magnitude * truth; break;
+      case FaultKind::kScale:
+        y += f.magnitude * truth;
+        break;
       case FaultKind::kStuck:
         if (std::isnan(held_[i])) held_[i] = y;
         y = held_[i];
         break;
-      case FaultKind::kStale: y = std::numeric_limits<double>::quiet_NaN(); break;
-      case FaultKind::kInvalid: y = std::numeric_limits<double>::infinity(); break;
-      case FaultKind::kUnknown: break;
+      case FaultKind::kStale:
+        y = std::numeric_limits<double>::quiet_NaN();
+        break;
+      case FaultKind::kInvalid:
+        y = std::numeric_limits<double>::infinity();
+        break;
+      case FaultKind::kUnknown:
+        break;
     }
   }
   return y;

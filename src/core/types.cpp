@@ -4,35 +4,52 @@ namespace usvfdi {
 
 const char* to_string(Sensor s) {
   switch (s) {
-    case Sensor::kAccelerometer: return "accelerometer";
-    case Sensor::kGyro: return "gyro";
-    case Sensor::kUnknown: return "unknown";
+    case Sensor::kAccelerometer:
+      return "accelerometer";
+    case Sensor::kGyro:
+      return "gyro";
+    case Sensor::kUnknown:
+      return "unknown";
   }
   return "unknown";
 }
 
 const char* to_string(FaultKind k) {
   switch (k) {
-    case FaultKind::kUnknown: return "unknown";
-    case FaultKind::kBias: return "bias";
-    case FaultKind::kDrift: return "drift";
-    case FaultKind::kStuck: return "stuck";
-    case FaultKind::kNoise: return "noise";
-    case FaultKind::kSpikes: return "spikes";
-    case FaultKind::kScale: return "scale";
-    case FaultKind::kStale: return "stale";
-    case FaultKind::kInvalid: return "invalid";
+    case FaultKind::kUnknown:
+      return "unknown";
+    case FaultKind::kBias:
+      return "bias";
+    case FaultKind::kDrift:
+      return "drift";
+    case FaultKind::kStuck:
+      return "stuck";
+    case FaultKind::kNoise:
+      return "noise";
+    case FaultKind::kSpikes:
+      return "spikes";
+    case FaultKind::kScale:
+      return "scale";
+    case FaultKind::kStale:
+      return "stale";
+    case FaultKind::kInvalid:
+      return "invalid";
   }
   return "unknown";
 }
 
 const char* to_string(FaultState s) {
   switch (s) {
-    case FaultState::kNormal: return "normal";
-    case FaultState::kRaised: return "raised";
-    case FaultState::kActiveAcknowledged: return "active_acknowledged";
-    case FaultState::kClearedUnacknowledged: return "cleared";
-    case FaultState::kAcknowledged: return "acknowledged";
+    case FaultState::kNormal:
+      return "normal";
+    case FaultState::kRaised:
+      return "raised";
+    case FaultState::kActiveAcknowledged:
+      return "active_acknowledged";
+    case FaultState::kClearedUnacknowledged:
+      return "cleared";
+    case FaultState::kAcknowledged:
+      return "acknowledged";
   }
   return "normal";
 }

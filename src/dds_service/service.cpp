@@ -64,8 +64,8 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     if (log_) {
       log_(1, std::string("event #") + std::to_string(e.sequence) + " " + to_string(e.sensor) +
                   " " + to_string(e.state) + " kind=" + to_string(e.kind) +
-                  " C_a=" + std::to_string(e.c_a) + " C_g=" + std::to_string(e.c_g) + " t=" +
-                  std::to_string(e.t) + ": " + e.message);
+                  " C_a=" + std::to_string(e.c_a) + " C_g=" + std::to_string(e.c_g) +
+                  " t=" + std::to_string(e.t) + ": " + e.message);
     }
   };
   auto on_status = [this, mmsi, iso](const PipelineStatus& s) {
@@ -73,9 +73,9 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   };
   pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, cfg_.pipeline, on_event, on_status, log_);
   listener_ = std::make_unique<Listener>(pipeline_.get(), mmsi);
-  DataReader& ins = dds_->create_reader(
-      dds::TopicId::kIns, cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
-                                               : dds::profiles::kInsReaderBestEffort);
+  DataReader& ins = dds_->create_reader(dds::TopicId::kIns,
+                                        cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
+                                                             : dds::profiles::kInsReaderBestEffort);
   DataReader& rudder = dds_->create_reader(
       dds::TopicId::kRudder, cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
                                                   : dds::profiles::kRudderReaderBestEffort);

@@ -88,12 +88,19 @@ ServiceConfig load_service_config(const std::string& path) {
         for (const auto& t : v) {
           const std::string tk = t.first.as<std::string>();
           const std::string name = get<std::string>(path, t.second, key + "." + tk, "a topic name");
-          if (tk == "ins") cfg.dds.topics.ins = name;
-          else if (tk == "rudder") cfg.dds.topics.rudder = name;
-          else if (tk == "fault_event") cfg.dds.topics.fault_event = name;
-          else if (tk == "fault_ack") cfg.dds.topics.fault_ack = name;
-          else if (tk == "status") cfg.dds.topics.status = name;
-          else fail(path, t.second, key + "." + tk, "unknown topic (ins, rudder, fault_event, fault_ack, status)");
+          if (tk == "ins")
+            cfg.dds.topics.ins = name;
+          else if (tk == "rudder")
+            cfg.dds.topics.rudder = name;
+          else if (tk == "fault_event")
+            cfg.dds.topics.fault_event = name;
+          else if (tk == "fault_ack")
+            cfg.dds.topics.fault_ack = name;
+          else if (tk == "status")
+            cfg.dds.topics.status = name;
+          else
+            fail(path, t.second, key + "." + tk,
+                 "unknown topic (ins, rudder, fault_event, fault_ack, status)");
         }
       } else if (key == "partitions") {
         cfg.dds.publisher_partitions = strings(path, v, key);
@@ -105,7 +112,7 @@ ServiceConfig load_service_config(const std::string& path) {
         if (!(r > 0) || !std::isfinite(r)) fail(path, v, key, "must be a positive rate in Hz");
         cfg.pipeline.status_period = 1.0 / r;
       } else if (key == "log_level") {
-        static const std::set<std::string> levels = {"trace", "debug", "info", "warn",
+        static const std::set<std::string> levels = {"trace", "debug",    "info", "warn",
                                                      "error", "critical", "off"};
         cfg.log_level = get<std::string>(path, v, key, "a log level");
         if (!levels.count(cfg.log_level)) {

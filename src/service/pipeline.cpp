@@ -225,7 +225,8 @@ void FdiPipeline::isolation_loop() {
       assembler_.drain(&batch, true);
       for (const Sample& s : batch) process(s);
       // A missing sample at the silent time lets the stale checks see the silence.
-      if (std::isfinite(last_t_)) process(Sample{last_t_ + seconds(now - last_ins), kNaN, kNaN, kNaN});
+      if (std::isfinite(last_t_))
+        process(Sample{last_t_ + seconds(now - last_ins), kNaN, kNaN, kNaN});
     }
     if (seconds(now - last_status) >= opt_.status_period) {
       last_status = now;

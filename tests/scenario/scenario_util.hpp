@@ -13,8 +13,8 @@
 namespace usvfdi::scenario {
 
 struct RunResult {
-  std::vector<FaultEvent> events;       ///< every latched-state change
-  std::vector<Estimate> estimates;      ///< one per second
+  std::vector<FaultEvent> events;   ///< every latched-state change
+  std::vector<Estimate> estimates;  ///< one per second
   double t_armed = kNaN;
   IsolatorStatus final_status;
   Estimate final_estimate;
@@ -55,15 +55,14 @@ inline RunResult run(const SimConfig& sim, const EngineConfig& cfg) {
 /// How one injected fault was seen.
 struct FaultScore {
   FaultInjection fault;
-  bool detected = false;       ///< a raise on any sensor within the fault window (+grace)
-  bool isolated = false;       ///< the first raise named the right sensor
+  bool detected = false;                 ///< a raise on any sensor within the fault window (+grace)
+  bool isolated = false;                 ///< the first raise named the right sensor
   FaultKind kind = FaultKind::kUnknown;  ///< kind of the first raise
-  double delay = kNaN;         ///< first raise - onset [s]
-  double recovery = kNaN;      ///< clear of that raise - fault end [s]
+  double delay = kNaN;                   ///< first raise - onset [s]
+  double recovery = kNaN;                ///< clear of that raise - fault end [s]
 };
 
-inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r,
-                                     double grace = 2.0) {
+inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r, double grace = 2.0) {
   std::vector<FaultScore> scores;
   for (const FaultInjection& f : sim.faults) {
     FaultScore s;
@@ -74,7 +73,10 @@ inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r,
       s.detected = true;
       s.isolated = e.sensor == f.sensor;
       s.kind = e.kind;
-      for (const FaultEvent& u : r.events) if (u.sensor == e.sensor && u.t > e.t && u.t <= f.t_end + grace && u.message.rfind("kind refined", 0) == 0) s.kind = u.kind;
+      for (const FaultEvent& u : r.events)
+        if (u.sensor == e.sensor && u.t > e.t && u.t <= f.t_end + grace &&
+            u.message.rfind("kind refined", 0) == 0)
+          s.kind = u.kind;
       s.delay = e.t - f.t_start;
       for (const FaultEvent& c : r.events) {
         if (c.sensor == e.sensor && c.t > e.t &&
@@ -116,9 +118,9 @@ inline std::vector<FaultInjection> every_kind(const VesselModel& v, double t0, d
     double mag_sigmas;  // in units of the channel's noise (scale: relative gain)
   };
   const std::vector<K> kinds = {
-      {FaultKind::kBias, 10.0},   {FaultKind::kDrift, 20.0 / 30.0}, {FaultKind::kStuck, 0.0},
-      {FaultKind::kNoise, 6.0},   {FaultKind::kSpikes, 25.0},       {FaultKind::kScale, 0.5},
-      {FaultKind::kStale, 0.0},   {FaultKind::kInvalid, 0.0},
+      {FaultKind::kBias, 10.0}, {FaultKind::kDrift, 20.0 / 30.0}, {FaultKind::kStuck, 0.0},
+      {FaultKind::kNoise, 6.0}, {FaultKind::kSpikes, 25.0},       {FaultKind::kScale, 0.5},
+      {FaultKind::kStale, 0.0}, {FaultKind::kInvalid, 0.0},
   };
   std::vector<FaultInjection> out;
   double t = t0;

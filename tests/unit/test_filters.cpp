@@ -70,7 +70,7 @@ TEST(FohLowPass, ExactForInputsLinearBetweenSamples) {
   std::mt19937_64 rng(0xF0A1);
   std::uniform_real_distribution<double> uval(-5.0, 5.0);
   std::vector<double> xs = {1e-6, 1e-3 * (1 - 1e-12), 1e-3, 1e-3 * (1 + 1e-12), 1.0 - 1e-12,
-                            1.0, 1.0 + 1e-12, 50.0};
+                            1.0,  1.0 + 1e-12,        50.0};
   for (int i = 0; i < 400; ++i) xs.push_back(-1.0);  // random
   for (double xfix : xs) {
     StepDraw d = draw_step(rng);
@@ -204,10 +204,9 @@ TEST(FohLowPass, ErrorOrderOnASmoothInputIsTwoPlainAndThreeCurved) {
     double z = 0.0;
     for (int k = 0; k < n; ++k) {
       const double t0 = k * h, t1 = (k + 1) * h;
-      const double udd =
-          k == 0 ? 0.0
-                 : FohLowPass::curvature(std::sin(w * (t0 - h)), std::sin(w * t0),
-                                         std::sin(w * t1), h, h);
+      const double udd = k == 0 ? 0.0
+                                : FohLowPass::curvature(std::sin(w * (t0 - h)), std::sin(w * t0),
+                                                        std::sin(w * t1), h, h);
       z = curved ? f.step_curved(std::sin(w * t0), std::sin(w * t1), udd, z)
                  : f.step(std::sin(w * t0), std::sin(w * t1), z);
     }

@@ -1,7 +1,8 @@
 // Property tests of the DREM identification of A (Identifier), both the paper's two-filter
 // form and the Kreisselmeier form, on noise-free data generated in closed form:
 //   delta(t) = sum_j alpha_j sin(w_j t + phi_j),
-//   x(t) = x_ss(t) + e^{A t} (x0 - x_ss(0)),  x_ss(t) = sum_j Im[(i w_j - A)^{-1} B alpha_j e^{i(w_j t + phi_j)}]
+//   x(t) = x_ss(t) + e^{A t} (x0 - x_ss(0)),  x_ss(t) = sum_j Im[(i w_j - A)^{-1} B alpha_j
+//   e^{i(w_j t + phi_j)}]
 // (the transient is propagated with expm(A h), so the data are exact to rounding).
 #include <gtest/gtest.h>
 
@@ -134,7 +135,8 @@ TEST_P(DremProperty, MixedRegressorIdentityAndLinearRegressionHoldOnExactData) {
       ++checked;
     }
     EXPECT_LT(reg_err / q_max, 2e-5) << name(GetParam()) << " case " << c << " t=" << t_reg;
-    EXPECT_LT(id_err, identity_tolerance(GetParam())) << name(GetParam()) << " case " << c << " t=" << t_id;
+    EXPECT_LT(id_err, identity_tolerance(GetParam()))
+        << name(GetParam()) << " case " << c << " t=" << t_id;
     worst_regression = std::max(worst_regression, reg_err / q_max);
     worst_identity = std::max(worst_identity, id_err);
     ASSERT_GT(checked, 500) << "the regressor was never excited; the test checks nothing";
@@ -142,8 +144,8 @@ TEST_P(DremProperty, MixedRegressorIdentityAndLinearRegressionHoldOnExactData) {
     const Mat2 Ahat = id.estimate().A;
     EXPECT_LT((Ahat - A).norm() / A.norm(), 1e-4) << name(GetParam()) << " case " << c;
   }
-  std::cout << "[ INFO     ] worst relative errors: m = A q " << worst_regression
-            << ", h = psi a " << worst_identity << "\n";
+  std::cout << "[ INFO     ] worst relative errors: m = A q " << worst_regression << ", h = psi a "
+            << worst_identity << "\n";
 }
 
 TEST_P(DremProperty, EachEstimateConvergesMonotonically) {

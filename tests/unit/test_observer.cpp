@@ -359,8 +359,10 @@ TEST(StructuredResidual, EachSensorFaultStaysOnItsOwnDirection) {
     }
     const double fmax = std::max(std::abs(f.back()), std::abs(mag));
     // WHEN both observers run on the healthy and on the faulty data
-    const std::vector<Vec2> rv_ok = residuals(dv, kV, B, p, y_ok), rv_bad = residuals(dv, kV, B, p, y_bad);
-    const std::vector<Vec2> rg_ok = residuals(dg, kR, B, p, y_ok), rg_bad = residuals(dg, kR, B, p, y_bad);
+    const std::vector<Vec2> rv_ok = residuals(dv, kV, B, p, y_ok),
+                            rv_bad = residuals(dv, kV, B, p, y_bad);
+    const std::vector<Vec2> rg_ok = residuals(dg, kR, B, p, y_ok),
+                            rg_bad = residuals(dg, kR, B, p, y_bad);
     // THEN the observer driven by the healthy sensor is untouched by the fault: its full
     //   residual changes by exactly f l_faulty (r^G = l_a f_a, r^V = l_g f_g)
     const std::vector<Vec2>& other_ok = faulty == kV ? rg_ok : rv_ok;

@@ -75,7 +75,7 @@ TEST(SampleAssembler, HoldsThenDropsALateRudder) {
   for (int k = 0; k <= 100; ++k) a.add_ins({0.01 * k, 0.0, 0.0, true, true});
   a.drain(&out);
   ASSERT_FALSE(out.empty());
-  EXPECT_DOUBLE_EQ(out.front().delta, 0.2);  // held
+  EXPECT_DOUBLE_EQ(out.front().delta, 0.2);   // held
   EXPECT_TRUE(std::isnan(out.back().delta));  // older than rudder_timeout: missing
 }
 

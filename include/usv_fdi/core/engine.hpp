@@ -63,8 +63,8 @@ class FdiEngine {
   Identifier ident_;
   Isolator iso_;
   IdentificationGate gate_;
-  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer),
-                                     FaultLatch(Sensor::kGyro), FaultLatch(Sensor::kUnknown)};
+  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
+                                     FaultLatch(Sensor::kUnknown)};
   std::vector<Detection> detections_;
   std::uint64_t frozen_samples_ = 0;
 };

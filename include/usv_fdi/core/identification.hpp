@@ -36,7 +36,7 @@ struct IdentificationParams {
   double warmup_time = -1;  ///< filter warm-up before regressions are used [s]; <0: 10/min(eps)
   double max_gap = 1.0;     ///< a time gap longer than this restarts the filters [s]
   bool curvature_correction = true;  ///< filter the inputs' curvature too (O(h^3) error)
-  Vec4 a0 = Vec4::Zero();   ///< initial estimate [a1 a2 a3 a4]
+  Vec4 a0 = Vec4::Zero();            ///< initial estimate [a1 a2 a3 a4]
   // Convergence criterion (reported, and what arms the isolation thread).
   double min_excitation = 0.01;    ///< normalised excitation in [0,1] needed to converge
   double settle_window = 1.0;      ///< length of one settling window [s]
@@ -95,7 +95,7 @@ class Identifier {
   bool have_prev_ = false;
   bool restart_pending_ = true;
   Sample prev_{};
-  Sample prev2_{};        ///< the sample before prev_ (for the curvature)
+  Sample prev2_{};  ///< the sample before prev_ (for the curvature)
   bool have_prev2_ = false;
   double t_start_ = kNaN;  ///< time the filters (re)started
   // filter states: F1[y], F1[delta], F2[y], F2[delta]

@@ -25,42 +25,42 @@
 namespace usvfdi {
 
 struct IsolationParams {
-  Vec2 poles_v = Vec2(-0.5, -0.7);  ///< poles of observer V [1/s]
-  Vec2 poles_g = Vec2(-0.5, -0.7);  ///< poles of observer G [1/s]
-  double min_observability = 1e-3;  ///< refuse an observer design below this index
+  Vec2 poles_v = Vec2(-0.5, -0.7);    ///< poles of observer V [1/s]
+  Vec2 poles_g = Vec2(-0.5, -0.7);    ///< poles of observer G [1/s]
+  double min_observability = 1e-3;    ///< refuse an observer design below this index
   double redesign_tolerance = 0.005;  ///< relative change of A that triggers a redesign
   /// Sensor noise. The residual scales are always learned on healthy data after arming
   /// (they include model mismatch); configured sensor noise sets their floors.
-  double sigma_v = 0.0;     ///< accelerometer-channel noise [m/s]; 0: floors only
-  double sigma_r = 0.0;     ///< gyro noise [rad/s]; 0: floors only
-  double sigma_floor_v = 1e-4;  ///< floor of every v-channel scale [m/s]
-  double sigma_floor_r = 1e-5;  ///< floor of every r-channel scale [rad/s]
-  double settle_time = -1;  ///< observer settling after arming [s]; <0: 3 / min|pole|
-  double learn_time = 60.0;  ///< healthy data used to learn scales and threshold [s]
-  double window = 0.5;       ///< evaluation window J_N [s]
-  int min_window_samples = 10;  ///< the window holds at least this many samples
-  double clip = 4.0;         ///< whitened residuals are clipped to +-clip inside J_N
-  double threshold = 6.0;    ///< minimum enter threshold on J_N, D_N (whitened mean square)
+  double sigma_v = 0.0;           ///< accelerometer-channel noise [m/s]; 0: floors only
+  double sigma_r = 0.0;           ///< gyro noise [rad/s]; 0: floors only
+  double sigma_floor_v = 1e-4;    ///< floor of every v-channel scale [m/s]
+  double sigma_floor_r = 1e-5;    ///< floor of every r-channel scale [rad/s]
+  double settle_time = -1;        ///< observer settling after arming [s]; <0: 3 / min|pole|
+  double learn_time = 60.0;       ///< healthy data used to learn scales and threshold [s]
+  double window = 0.5;            ///< evaluation window J_N [s]
+  int min_window_samples = 10;    ///< the window holds at least this many samples
+  double clip = 4.0;              ///< whitened residuals are clipped to +-clip inside J_N
+  double threshold = 6.0;         ///< minimum enter threshold on J_N, D_N (whitened mean square)
   double threshold_margin = 1.5;  ///< learned threshold: at least margin * 99.9 % quantile
-  double threshold_k = 8.0;  ///< learned threshold: median + k robust std of healthy J_N
-  double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
-  double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]
-  double leave_time = 1.0;   ///< below the leave threshold this long clears [s]
-  double min_active_time = 3.0;  ///< a residual fault stays raised at least this long [s]
-  double c_min = 0.8;        ///< isolation needs C_i >= c_min ...
-  double c_margin = 0.3;     ///< ... and C_i - C_other >= c_margin; else sensor unknown
-  double resume_time = 2.0;  ///< quiet time before identification resumes [s]
+  double threshold_k = 8.0;       ///< learned threshold: median + k robust std of healthy J_N
+  double exit_ratio = 0.5;        ///< leave threshold = exit_ratio * enter threshold
+  double enter_time = 0.06;       ///< J_N above threshold this long raises (at least 1 sample) [s]
+  double leave_time = 1.0;        ///< below the leave threshold this long clears [s]
+  double min_active_time = 3.0;   ///< a residual fault stays raised at least this long [s]
+  double c_min = 0.8;             ///< isolation needs C_i >= c_min ...
+  double c_margin = 0.3;          ///< ... and C_i - C_other >= c_margin; else sensor unknown
+  double resume_time = 2.0;       ///< quiet time before identification resumes [s]
   // Sensor-level checks.
-  double stale_timeout = 0.5;  ///< no valid value for this long: stale [s]
-  double stuck_time = 0.5;     ///< value unchanged for this long: stuck [s]
-  int stuck_min_samples = 5;   ///< ... and for at least this many samples
-  double max_abs_v = 20.0;     ///< |v| above this is invalid [m/s]
-  double max_abs_r = 3.0;      ///< |r| above this is invalid [rad/s]
-  double max_abs_delta = 1.6;  ///< |delta| above this is invalid [rad]
-  double spike_gate = 8.0;     ///< |s_i| above this on 1-2 samples is a spike
-  double spike_window = 3.0;   ///< spikes are counted over this window [s]
-  int spike_count = 3;         ///< this many spikes in the window raise a spikes fault
-  int invalid_count = 3;       ///< this many invalid values in spike_window raise invalid
+  double stale_timeout = 0.5;    ///< no valid value for this long: stale [s]
+  double stuck_time = 0.5;       ///< value unchanged for this long: stuck [s]
+  int stuck_min_samples = 5;     ///< ... and for at least this many samples
+  double max_abs_v = 20.0;       ///< |v| above this is invalid [m/s]
+  double max_abs_r = 3.0;        ///< |r| above this is invalid [rad/s]
+  double max_abs_delta = 1.6;    ///< |delta| above this is invalid [rad]
+  double spike_gate = 8.0;       ///< |s_i| above this on 1-2 samples is a spike
+  double spike_window = 3.0;     ///< spikes are counted over this window [s]
+  int spike_count = 3;           ///< this many spikes in the window raise a spikes fault
+  int invalid_count = 3;         ///< this many invalid values in spike_window raise invalid
   double classify_window = 8.0;  ///< history used to name the kind of a fault [s]
 
   /// Throws std::invalid_argument naming the offending field.
@@ -83,9 +83,9 @@ struct Detection {
 /// Reason flags for the inputs (FdiStatus).
 struct InputHealth {
   bool v_ok = true, r_ok = true, delta_ok = true;
-  std::uint64_t rejected_time = 0;     ///< samples whose time did not increase
-  std::uint64_t invalid_values = 0;    ///< NaN/Inf/absurd values seen
-  std::uint64_t gaps = 0;              ///< gaps longer than stale_timeout
+  std::uint64_t rejected_time = 0;   ///< samples whose time did not increase
+  std::uint64_t invalid_values = 0;  ///< NaN/Inf/absurd values seen
+  std::uint64_t gaps = 0;            ///< gaps longer than stale_timeout
 };
 
 struct IsolatorStatus {
@@ -137,9 +137,7 @@ class Isolator {
     unsigned sources = 0;  ///< bitmask of Source
     FaultKind kind = FaultKind::kUnknown;
   };
-  enum Source : unsigned {
-    kResidual = 1u, kStale = 2u, kStuck = 4u, kSpikes = 8u, kInvalid = 16u
-  };
+  enum Source : unsigned { kResidual = 1u, kStale = 2u, kStuck = 4u, kSpikes = 8u, kInvalid = 16u };
   struct Channel {
     double last_valid_t = kNaN;
     double last_value = kNaN;
@@ -190,9 +188,9 @@ class Isolator {
   std::array<std::deque<std::pair<double, double>>, 2> hist_s_;  ///< (t, whitened structured)
   std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
   std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
-  std::array<Channel, 3> ch_;  ///< v, r, delta
-  std::array<Condition, 3> cond_;  ///< accelerometer, gyro, unknown
-  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown
+  std::array<Channel, 3> ch_;                                    ///< v, r, delta
+  std::array<Condition, 3> cond_;                                ///< accelerometer, gyro, unknown
+  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};          ///< per sensor a/g/unknown
   std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
   std::array<double, 3> raised_at_{kNaN, kNaN, kNaN};  ///< time of the residual raise
   double last_delta_ = kNaN;

@@ -19,14 +19,14 @@ struct FaultEvent {
   Sensor sensor = Sensor::kUnknown;
   FaultState state = FaultState::kNormal;
   FaultKind kind = FaultKind::kUnknown;
-  double c_a = 0.0, c_g = 0.0;     ///< isolation confidences at the decision
-  double statistic = 0.0;          ///< residual statistic at this event
-  double threshold = 0.0;          ///< threshold in force
-  double onset_time = kNaN;        ///< estimated fault onset [s, source clock]
-  double detection_time = kNaN;    ///< time of the raise [s, source clock]
-  double t = kNaN;                 ///< time of this event [s, source clock]
-  std::uint64_t sequence = 0;      ///< per-instance, increases with every event
-  Mat2 A = Mat2::Zero();           ///< estimate of A in force
+  double c_a = 0.0, c_g = 0.0;   ///< isolation confidences at the decision
+  double statistic = 0.0;        ///< residual statistic at this event
+  double threshold = 0.0;        ///< threshold in force
+  double onset_time = kNaN;      ///< estimated fault onset [s, source clock]
+  double detection_time = kNaN;  ///< time of the raise [s, source clock]
+  double t = kNaN;               ///< time of this event [s, source clock]
+  std::uint64_t sequence = 0;    ///< per-instance, increases with every event
+  Mat2 A = Mat2::Zero();         ///< estimate of A in force
   std::string message;
 };
 

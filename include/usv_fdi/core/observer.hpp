@@ -14,10 +14,10 @@ namespace usvfdi {
 /// Result of a pole-placement design for the pair (A, e_c^T).
 struct ObserverDesign {
   bool ok = false;
-  Vec2 k = Vec2::Zero();         ///< continuous gain: x' = (A - k e_c^T) x + B delta + k y_c
-  Mat2 F = Mat2::Zero();         ///< A - k e_c^T
-  double observability = 0.0;    ///< scale-free observability index (see place_poles)
-  std::string reason;            ///< why the design was refused (empty when ok)
+  Vec2 k = Vec2::Zero();       ///< continuous gain: x' = (A - k e_c^T) x + B delta + k y_c
+  Mat2 F = Mat2::Zero();       ///< A - k e_c^T
+  double observability = 0.0;  ///< scale-free observability index (see place_poles)
+  std::string reason;          ///< why the design was refused (empty when ok)
 };
 
 /// Places the poles p1, p2 (real, negative) of A - k e_c^T, c = channel (kV or kR).

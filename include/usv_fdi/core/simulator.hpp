@@ -34,20 +34,20 @@ struct SimConfig {
   double rate_hz = 50.0;
   double duration = 100.0;  ///< [s]
   std::uint64_t seed = 1;
-  double sigma_v = -1;      ///< measurement noise [m/s]; < 0: the vessel's realistic value
-  double sigma_r = -1;      ///< [rad/s]; < 0: the vessel's realistic value
+  double sigma_v = -1;       ///< measurement noise [m/s]; < 0: the vessel's realistic value
+  double sigma_r = -1;       ///< [rad/s]; < 0: the vessel's realistic value
   double sigma_delta = 0.0;  ///< rudder measurement noise [rad]
   double disturbance = 0.0;  ///< std of white process noise on v' and r' (waves) [unit/s/sqrt(s)]
   Steering steering = Steering::kAutopilot;
   double sine_amplitude = -1;  ///< [rad]; < 0: the vessel's
   double sine_frequency = -1;  ///< [rad/s]; < 0: the vessel's
-  int substeps = 10;  ///< RK4 steps per sample
+  int substeps = 10;           ///< RK4 steps per sample
   std::vector<FaultInjection> faults;
 };
 
 struct SimRow {
   double t = 0.0;
-  double v = 0.0, r = 0.0, delta = 0.0;           ///< measured (faults applied)
+  double v = 0.0, r = 0.0, delta = 0.0;  ///< measured (faults applied)
   double v_true = 0.0, r_true = 0.0, delta_true = 0.0, psi = 0.0, psi_ref = 0.0;
   FaultKind fault_a = FaultKind::kUnknown;  ///< kUnknown: no accelerometer fault
   FaultKind fault_g = FaultKind::kUnknown;  ///< kUnknown: no gyro fault

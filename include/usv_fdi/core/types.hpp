@@ -47,11 +47,11 @@ enum class FaultKind : std::uint8_t {
 
 /// Alert states after IEC 62923 bridge alert management.
 enum class FaultState : std::uint8_t {
-  kNormal = 0,                 ///< no fault; nothing latched
-  kRaised,                     ///< active, unacknowledged
-  kActiveAcknowledged,         ///< active, acknowledged by an operator
-  kClearedUnacknowledged,      ///< rectified, not yet acknowledged: stays latched
-  kAcknowledged,               ///< rectified and acknowledged (the final word on an instance)
+  kNormal = 0,             ///< no fault; nothing latched
+  kRaised,                 ///< active, unacknowledged
+  kActiveAcknowledged,     ///< active, acknowledged by an operator
+  kClearedUnacknowledged,  ///< rectified, not yet acknowledged: stays latched
+  kAcknowledged,           ///< rectified and acknowledged (the final word on an instance)
 };
 
 const char* to_string(Sensor s);

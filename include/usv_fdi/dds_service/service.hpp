@@ -17,7 +17,7 @@ struct ServiceConfig {
   EngineConfig engine;
   PipelineOptions pipeline;
   usv_fdi::dds::DdsConfig dds;
-  std::uint32_t mmsi = 0;  ///< the vessel this sidecar watches (required, > 0)
+  std::uint32_t mmsi = 0;        ///< the vessel this sidecar watches (required, > 0)
   bool reliable_inputs = false;  ///< INS and rudder readers RELIABLE instead of BEST_EFFORT
   std::string log_level = "info";
   std::string config_file;  ///< where it was loaded from (for messages)

@@ -153,8 +153,8 @@ class FdiPipeline {
 
   // Isolation thread state.
   Isolator iso_;
-  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer),
-                                     FaultLatch(Sensor::kGyro), FaultLatch(Sensor::kUnknown)};
+  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
+                                     FaultLatch(Sensor::kUnknown)};
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
   double last_t_ = kNaN;
