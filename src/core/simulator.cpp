@@ -132,7 +132,8 @@ bool Simulator::next(SimRow* row) {
       z_ += hs / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
       if (c_.disturbance > 0) {
         z_(0) += c_.disturbance * std::sqrt(hs) * n01_(rng_);
-        z_(1) += c_.disturbance * std::sqrt(hs) * n01_(rng_) * sigma_[1] / sigma_[0];
+        z_(1) += c_.disturbance * std::sqrt(hs) * n01_(rng_) *
+                 (m.sigma_v > 0 ? m.sigma_r / m.sigma_v : 1.0);
       }
     }
   }

@@ -352,13 +352,8 @@ TEST(Simulator, NoiseFreeIsExact) {
 }
 
 TEST(Simulator, WaveDisturbanceWithNoiseFreeSensorsStaysFinite) {
-  // simulator.cpp scales the yaw-rate disturbance by sigma_r / sigma_v (the header
-  // documents one std on v' and r'); with sigma_v = 0 that is 0/0 or x/0, and r becomes
-  // NaN/Inf from the first sample on.
-  GTEST_SKIP() << "BUG (src/core/simulator.cpp, Simulator::next): process noise on r' is "
-                  "multiplied by sigma_[1] / sigma_[0], which is NaN/Inf for noise-free "
-                  "sensors (sigma_v = 0) with disturbance > 0; the header documents a "
-                  "disturbance std on v' and r' without that factor";
+  // The yaw-rate disturbance is scaled by the vessel's realistic noise ratio, never by the
+  // configured sensor noise (which may be zero).
   SimConfig c;
   c.vessel = otter();
   c.sigma_v = 0.0;

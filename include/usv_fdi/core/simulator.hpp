@@ -37,7 +37,9 @@ struct SimConfig {
   double sigma_v = -1;       ///< measurement noise [m/s]; < 0: the vessel's realistic value
   double sigma_r = -1;       ///< [rad/s]; < 0: the vessel's realistic value
   double sigma_delta = 0.0;  ///< rudder measurement noise [rad]
-  double disturbance = 0.0;  ///< std of white process noise on v' and r' (waves) [unit/s/sqrt(s)]
+  /// White process noise (waves): std on v' [m/s^2/sqrt(s)]; on r' the same times the
+  /// vessel's realistic sigma_r / sigma_v [rad/s^2/sqrt(s)], whatever the sensor noise.
+  double disturbance = 0.0;
   Steering steering = Steering::kAutopilot;
   double sine_amplitude = -1;  ///< [rad]; < 0: the vessel's
   double sine_frequency = -1;  ///< [rad/s]; < 0: the vessel's
