@@ -13,11 +13,17 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
   std::vector<FaultEvent> events;
   double first_t = kNaN, last_t = kNaN, last_record = kNaN;
   bool last_converged = false, last_armed = false;
+  FaultState latched[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};
 
   const auto emit = [&](const FaultEvent& e) {
     out.event(e);
     ++sum.events;
-    if (e.state == FaultState::kRaised) ++sum.raised[static_cast<int>(e.sensor)];
+    // A raise is a transition into raised; a refined kind republishes raised and is no raise.
+    FaultState& before = latched[static_cast<int>(e.sensor)];
+    if (e.state == FaultState::kRaised && before != FaultState::kRaised) {
+      ++sum.raised[static_cast<int>(e.sensor)];
+    }
+    before = e.state;
   };
   const auto finish = [&] {
     if (!std::isnan(last_t)) {
