@@ -39,7 +39,7 @@ fail() {
 fleet_netns_up "$name" 2 || fail "namespaces not made"
 server="$(fleet_netns_addr "$name" shore)"
 port=11811
-export FASTRTPS_DEFAULT_PROFILES_FILE="$here/fleet_participants.xml"
+export FASTRTPS_DEFAULT_PROFILES_FILE="$here/../../docker/fleet_participants.xml"
 export ROS_DISCOVERY_SERVER="$server:$port"
 dds=(--profiles "$qos" --participant-profile usv_fdi_fleet_udp --domain 7 --partition fleet)
 
