@@ -9,6 +9,14 @@
 #   OUT/security_profiles.xml      Fast DDS XML participant profiles that enable all three plugins:
 #                                    usv_fdi_secure_<name>           builtin transports (SHM+UDPv4)
 #                                    usv_fdi_secure_<name>_loopback  UDPv4 on 127.0.0.1 only
+#                                    usv_fdi_secure_<name>_unicast   UDPv4, discovery by unicast to
+#                                                                    --initial-peers (if given)
+#
+# Fast DDS 2.9 (Debian bookworm) cannot combine DDS Security with a discovery server (the secure
+# discovery server came with Fast DDS 2.10; the 2.9 server aborts on an assertion in
+# SecurityManager::encode_rtps_message when given security properties). A secure fleet without
+# multicast therefore uses the _unicast profiles: SIMPLE discovery sent to a fixed list of
+# addresses (shore and vessels), see docker/README.md.
 #
 # Usage: scripts/make-security.sh OUT [options]
 #   --identity ROLE:NAME   add an identity (repeatable); ROLE is vessel, sensors, shore or observer.
@@ -20,6 +28,7 @@
 #   --path-prefix DIR      directory the files will be read from at run time, as written into
 #                          security_profiles.xml (default: OUT itself; e.g. /etc/usv-fdi/security
 #                          when OUT is mounted there in a container)
+#   --initial-peers LIST   comma-separated IPv4 addresses for the _unicast profiles
 #   --force                replace an existing OUT
 #
 # Private keys are written 0600 under OUT and must never be committed: this is a test PKI. A real
@@ -40,6 +49,7 @@ org="usv-fdi test fleet"
 days=30
 prefix=""
 force=0
+peers=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --identity) [ $# -ge 2 ] || die "--identity needs ROLE:NAME"; identities+=("$2"); shift 2 ;;
@@ -47,12 +57,20 @@ while [ $# -gt 0 ]; do
     --subject-org) [ $# -ge 2 ] || die "--subject-org needs a value"; org="$2"; shift 2 ;;
     --days) [ $# -ge 2 ] || die "--days needs a value"; days="$2"; shift 2 ;;
     --path-prefix) [ $# -ge 2 ] || die "--path-prefix needs a value"; prefix="$2"; shift 2 ;;
+    --initial-peers) [ $# -ge 2 ] || die "--initial-peers needs a value"; peers="$2"; shift 2 ;;
     --force) force=1; shift ;;
     *) die "unknown option '$1'" ;;
   esac
 done
 [ ${#identities[@]} -gt 0 ] || identities=(vessel:vessel sensors:sensors shore:shore observer:observer)
 case "$days" in '' | *[!0-9]* | 0) die "--days must be a positive whole number, not '$days'" ;; esac
+peer_list=()
+if [ -n "$peers" ]; then
+  IFS=, read -r -a peer_list <<<"$peers"
+  for a in "${peer_list[@]}"; do
+    [[ "$a" =~ ^[0-9]{1,3}(\.[0-9]{1,3}){3}$ ]] || die "--initial-peers: not an IPv4 address: '$a'"
+  done
+fi
 command -v openssl >/dev/null || die "openssl not found (scripts/packages.txt lists it)"
 for f in governance.xml permissions.xml.in; do
   [ -r "$templates/$f" ] || die "missing template $templates/$f"
@@ -142,6 +160,8 @@ profiles="$out/security_profiles.xml"
   printf '    <transport_descriptors>\n      <transport_descriptor>\n'
   printf '        <transport_id>usv_fdi_secure_udpv4_loopback</transport_id>\n        <type>UDPv4</type>\n'
   printf '        <interfaceWhiteList>\n          <address>127.0.0.1</address>\n        </interfaceWhiteList>\n'
+  printf '      </transport_descriptor>\n      <transport_descriptor>\n'
+  printf '        <transport_id>usv_fdi_secure_udpv4</transport_id>\n        <type>UDPv4</type>\n'
   printf '      </transport_descriptor>\n    </transport_descriptors>\n'
 } >"$profiles"
 
@@ -192,7 +212,9 @@ for id in "${identities[@]}"; do
   printf '%s\n' "$role" >"$dir/role"
   chmod 0644 "$dir/role"
   {
-    for variant in "" _loopback; do
+    variants=("" _loopback)
+    [ ${#peer_list[@]} -eq 0 ] || variants+=(_unicast)
+    for variant in "${variants[@]}"; do
       printf '    <participant profile_name="usv_fdi_secure_%s%s">\n      <rtps>\n' "$name" "$variant"
       printf '        <name>usv_fdi_%s</name>\n' "$name"
       if [ "$variant" = _loopback ]; then
@@ -202,6 +224,20 @@ for id in "${identities[@]}"; do
         printf '            </initialAnnouncements>\n          </discovery_config>\n'
         printf '          <initialPeersList>\n            <locator>\n              <udpv4>\n                <address>127.0.0.1</address>\n              </udpv4>\n            </locator>\n          </initialPeersList>\n        </builtin>\n'
         printf '        <userTransports>\n          <transport_id>usv_fdi_secure_udpv4_loopback</transport_id>\n        </userTransports>\n'
+        printf '        <useBuiltinTransports>false</useBuiltinTransports>\n'
+      fi
+      if [ "$variant" = _unicast ]; then
+        # SIMPLE discovery also sent by unicast to every address of the fleet (works where
+        # multicast does not); UDPv4 only, no SHM.
+        printf '        <builtin>\n          <discovery_config>\n            <initialAnnouncements>\n'
+        printf '              <count>20</count>\n              <period>\n                <sec>0</sec>\n                <nanosec>100000000</nanosec>\n              </period>\n'
+        printf '            </initialAnnouncements>\n          </discovery_config>\n'
+        printf '          <initialPeersList>\n'
+        for a in "${peer_list[@]}"; do
+          printf '            <locator>\n              <udpv4>\n                <address>%s</address>\n              </udpv4>\n            </locator>\n' "$a"
+        done
+        printf '          </initialPeersList>\n        </builtin>\n'
+        printf '        <userTransports>\n          <transport_id>usv_fdi_secure_udpv4</transport_id>\n        </userTransports>\n'
         printf '        <useBuiltinTransports>false</useBuiltinTransports>\n'
       fi
       security_properties "$name"
