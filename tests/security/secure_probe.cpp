@@ -23,7 +23,7 @@
 //     100 ms. Prints, for each entity asked for, "<entity> created" or "<entity> refused: <why>"
 //     (entity: fault_reader, ins_writer, ack_writer), then at the end
 //       fault instance mmsi=.. sensor=.. sequence=.. message=..    (one per instance received)
-//       summary faults=<instances> ins_written=<n> acks_written=<n>
+//       summary faults=<instances> ins_written=<n> acks_written=<n> first_fault_ms=<ms or -1>
 //     and exits 0.
 //
 // Exit code 3: usage error; 4: DDS error (e.g. the participant itself was refused).
@@ -254,7 +254,9 @@ int run_peer(const Options& o) {
   std::vector<fdi::FaultEvent> batch;
   unsigned ins_written = 0;
   unsigned acks_written = 0;
+  const auto start = Clock::now();
   const auto end = after(o.duration_s);
+  long first_fault_ms = -1;  // time to the first event received (authentication + matching)
   auto next_write = Clock::now();
   while (!g_stop.load() && Clock::now() < end) {
     if (Clock::now() >= next_write) {
@@ -292,6 +294,10 @@ int run_peer(const Options& o) {
       batch.clear();
       usv_fdi::dds::take_all(*faults, batch);
       for (const auto& e : batch) seen[{e.mmsi(), static_cast<unsigned>(e.sensor())}] = e;
+      if (first_fault_ms < 0 && !batch.empty()) {
+        first_fault_ms = static_cast<long>(
+            std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - start).count());
+      }
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -301,7 +307,8 @@ int run_peer(const Options& o) {
         " message=" + std::string(e.message().c_str()));
   }
   say("summary faults=" + std::to_string(seen.size()) + " ins_written=" +
-      std::to_string(ins_written) + " acks_written=" + std::to_string(acks_written));
+      std::to_string(ins_written) + " acks_written=" + std::to_string(acks_written) +
+      " first_fault_ms=" + std::to_string(first_fault_ms));
   return 0;
 }
 
