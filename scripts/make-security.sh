@@ -76,15 +76,7 @@ for f in governance.xml permissions.xml.in; do
   [ -r "$templates/$f" ] || die "missing template $templates/$f"
 done
 
-if [ -e "$out" ]; then
-  [ "$force" -eq 1 ] || die "$out exists (use --force to replace it)"
-  rm -rf "$out"
-fi
-mkdir -p "$out/ca"
-out="$(cd "$out" && pwd)"
-[ -n "$prefix" ] || prefix="$out"
-
-# Subject names of the permissions grants must equal the certificates' subjects.
+# Identities: ROLE:NAME with unique names (NAME becomes the certificate's CN and a directory).
 declare -A seen=()
 for id in "${identities[@]}"; do
   role="${id%%:*}"
@@ -95,6 +87,17 @@ for id in "${identities[@]}"; do
   [ -z "${seen[$name]:-}" ] || die "--identity '$id': name '$name' given twice"
   seen[$name]=1
 done
+
+case "$(realpath -m "$out")" in / | "$(realpath -m "$root")" | "$(realpath -m "${HOME:-/}")")
+  die "refusing to use '$out' as OUT" ;;
+esac
+if [ -e "$out" ]; then
+  [ "$force" -eq 1 ] || die "$out exists (use --force to replace it)"
+  rm -rf "$out"
+fi
+mkdir -p "$out/ca"
+out="$(cd "$out" && pwd)"
+[ -n "$prefix" ] || prefix="$out"
 
 quiet() { # runs openssl quietly, shows its output only when it fails
   local log
