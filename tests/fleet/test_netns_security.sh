@@ -53,20 +53,24 @@ for _ in $(seq 150); do
 done
 grep -q '^ready' "$work/sidecar.log" || fail "sidecar did not start"
 
-peer=(peer "${dds[@]}" --read-faults 1 --write-acks 1 --duration 8 --mmsi 257000001)
-fleet_netns_exec "$name" shore "$probe" "${peer[@]}" --security "$work/fleet/security_profiles.xml" \
-  --participant-profile usv_fdi_secure_shore_unicast --operator shore-op \
-  >"$work/shore.log" 2>"$work/shore.err" &
-shore_pid=$!
-fleet_netns_exec "$name" v2 "$probe" "${peer[@]}" --write-ins 1 \
+# The shore (control) stops 2 s after it has both events; the intruder runs from before the
+# shore starts until after it has finished, then gets SIGTERM (and prints its summary).
+peer=(peer "${dds[@]}" --read-faults 1 --write-acks 1 --duration 40 --mmsi 257000001)
+# `ip netns exec` directly (not the shell function) so that $! is the probe itself.
+ip netns exec "$name-v2" "$probe" "${peer[@]}" --write-ins 1 \
   --security "$work/foreign/security_profiles.xml" \
   --participant-profile usv_fdi_secure_shore_unicast --operator intruder \
-  >"$work/intruder.log" 2>"$work/intruder.err"
-intruder_rc=$?
-wait "$shore_pid"
+  >"$work/intruder.log" 2>"$work/intruder.err" &
+intruder_pid=$!
+fleet_netns_exec "$name" shore "$probe" "${peer[@]}" --until-faults 2 \
+  --security "$work/fleet/security_profiles.xml" \
+  --participant-profile usv_fdi_secure_shore_unicast --operator shore-op \
+  >"$work/shore.log" 2>"$work/shore.err"
 shore_rc=$?
-kill -TERM "$(jobs -p | head -n1)" 2>/dev/null
-sleep 1
+kill -TERM "$intruder_pid" 2>/dev/null
+wait "$intruder_pid"
+intruder_rc=$?
+sleep 0.5
 
 [ "$shore_rc" -eq 0 ] || fail "shore peer exited $shore_rc"
 [ "$intruder_rc" -eq 0 ] || fail "intruder peer exited $intruder_rc"

@@ -17,11 +17,12 @@
 //     timeout (exit 2).
 //
 //   usv_fdi_secure_probe peer ... [--read-faults 0|1] [--write-ins 0|1] [--write-acks 0|1]
-//       [--mmsi M] [--operator NAME] [--duration SECONDS]
-//     A fleet participant: for --duration seconds reads FaultEvents and/or writes one INS sample
-//     (mmsi M) and one FaultAck (operator NAME, acknowledging mmsi M sensor 0 sequence 1) every
-//     100 ms. Prints, for each entity asked for, "<entity> created" or "<entity> refused: <why>"
-//     (entity: fault_reader, ins_writer, ack_writer), then at the end
+//       [--mmsi M] [--operator NAME] [--duration SECONDS] [--until-faults K]
+//     A fleet participant: for --duration seconds (or until SIGTERM/SIGINT, or, with
+//     --until-faults K, until 2 s after K event instances arrived) reads FaultEvents and/or writes
+//     one INS sample (mmsi M) and one FaultAck (operator NAME, acknowledging mmsi M sensor 0
+//     sequence 1) every 100 ms. Prints, for each entity asked for, "<entity> created" or "<entity>
+//     refused: <why>" (entity: fault_reader, ins_writer, ack_writer), then at the end
 //       fault instance mmsi=.. sensor=.. sequence=.. message=..    (one per instance received)
 //       summary faults=<instances> ins_written=<n> acks_written=<n> first_fault_ms=<ms or -1>
 //     and exits 0.
@@ -75,6 +76,7 @@ struct Options {
   bool write_acks = false;
   std::string operator_id = "probe";
   double duration_s = 5.0;
+  unsigned until_faults = 0;
   double timeout_s = 30.0;
 };
 
@@ -139,6 +141,8 @@ Options parse(int argc, char** argv) {
       o.write_acks = parse_flag(flag, value);
     } else if (flag == "--operator") {
       o.operator_id = value;
+    } else if (flag == "--until-faults") {
+      o.until_faults = static_cast<unsigned>(parse_unsigned(flag, value));
     } else if (flag == "--duration") {
       o.duration_s = parse_seconds(flag, value);
     } else if (flag == "--timeout") {
@@ -258,7 +262,8 @@ int run_peer(const Options& o) {
   const auto end = after(o.duration_s);
   long first_fault_ms = -1;  // time to the first event received (authentication + matching)
   auto next_write = Clock::now();
-  while (!g_stop.load() && Clock::now() < end) {
+  std::optional<Clock::time_point> done_at;  // --until-faults: when to stop
+  while (!g_stop.load() && Clock::now() < end && !(done_at && Clock::now() >= *done_at)) {
     if (Clock::now() >= next_write) {
       next_write += std::chrono::milliseconds(100);
       if (ins != nullptr) {
@@ -294,6 +299,9 @@ int run_peer(const Options& o) {
       batch.clear();
       usv_fdi::dds::take_all(*faults, batch);
       for (const auto& e : batch) seen[{e.mmsi(), static_cast<unsigned>(e.sensor())}] = e;
+      if (o.until_faults > 0 && !done_at && seen.size() >= o.until_faults) {
+        done_at = Clock::now() + std::chrono::seconds(2);  // the acks written meanwhile arrive too
+      }
       if (first_fault_ms < 0 && !batch.empty()) {
         first_fault_ms = static_cast<long>(
             std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - start).count());

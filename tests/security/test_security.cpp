@@ -18,9 +18,9 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -38,7 +38,9 @@ namespace fs = std::filesystem;
 constexpr const char* kProbe = USV_FDI_SECURE_PROBE;
 constexpr const char* kQos = USV_FDI_QOS_PROFILES;
 constexpr std::uint32_t kVessel = 257000001;
-constexpr double kPeerSeconds = 6.0;
+// Upper bound of a peer's run. A control peer normally ends ~2 s after its participant matched
+// (measured here: first event 40 ms to 1.1 s after start; several seconds with both cores busy).
+constexpr double kMaxSeconds = 40.0;
 
 fs::path g_pki;  // set by the environment below
 
@@ -102,6 +104,9 @@ struct Peer {
   bool write_acks = false;
   std::uint32_t mmsi = kVessel;
   std::string operator_id;
+  /// > 0: stop 2 s after this many event instances arrived (a control that proves the sidecar
+  /// serves); 0: run until stopped by the test (an intruder, over the control's whole run).
+  unsigned until_faults = 0;
 };
 
 class SecurityTest : public ::testing::Test {
@@ -123,59 +128,106 @@ class SecurityTest : public ::testing::Test {
     std::vector<std::string> a = {kProbe, "sidecar"};
     for (const auto& s : common()) a.push_back(s);
     for (const auto& s : identity) a.push_back(s);
-    a.insert(a.end(), {"--mmsi", std::to_string(mmsi), "--sensors", "2", "--timeout", "60"});
+    a.insert(a.end(), {"--mmsi", std::to_string(mmsi), "--sensors", "2", "--timeout", "90"});
     auto p = std::make_unique<ChildProcess>(a);
     const auto line = p->read_line(milliseconds(15000));
     EXPECT_EQ(line.value_or("<nothing>"), "ready");
     return p;
   }
 
+  /// Starts a peer. A control (until_faults > 0) ends by itself, at the latest after kMaxSeconds;
+  /// any other peer runs until stop_peer() (or kMaxSeconds).
   std::unique_ptr<ChildProcess> start_peer(const Peer& peer) {
     std::vector<std::string> a = {kProbe, "peer"};
     for (const auto& s : common()) a.push_back(s);
     for (const auto& s : peer.identity) a.push_back(s);
-    a.insert(a.end(), {"--read-faults", peer.read_faults ? "1" : "0", "--write-ins",
-                       peer.write_ins ? "1" : "0", "--write-acks", peer.write_acks ? "1" : "0",
-                       "--mmsi", std::to_string(peer.mmsi), "--operator", peer.operator_id,
-                       "--duration", std::to_string(kPeerSeconds)});
+    a.insert(a.end(),
+             {"--read-faults", peer.read_faults ? "1" : "0", "--write-ins",
+              peer.write_ins ? "1" : "0", "--write-acks", peer.write_acks ? "1" : "0", "--mmsi",
+              std::to_string(peer.mmsi), "--operator", peer.operator_id, "--until-faults",
+              std::to_string(peer.until_faults), "--duration", std::to_string(kMaxSeconds)});
     return std::make_unique<ChildProcess>(a);
   }
 
   /// Collects a peer's output after its run (its exit code must be 0).
   static std::string finish_peer(ChildProcess& p) {
-    const std::string out = p.read_all(milliseconds(static_cast<int>(kPeerSeconds * 1000) + 20000));
+    const std::string out = p.read_all(milliseconds(static_cast<int>(kMaxSeconds * 1000) + 20000));
     const auto code = p.wait_exit(milliseconds(5000));
     EXPECT_EQ(code.value_or(-1), 0) << out;
     return out;
   }
 
-  /// Stops the sidecar and returns everything it printed.
-  static std::string finish_sidecar(ChildProcess& p) {
+  /// Ends a peer that runs until stopped (SIGTERM: it prints its summary and exits 0).
+  static std::string stop_peer(ChildProcess& p) {
     p.signal(SIGTERM);
-    const std::string out = p.read_all(milliseconds(10000));
-    EXPECT_EQ(p.wait_exit(milliseconds(5000)).value_or(-1), 0) << out;
-    return out;
+    return finish_peer(p);
+  }
+
+  /// Reads the sidecar's lines into *log until one starts with `prefix` (true) or `timeout`.
+  static bool wait_for_line(ChildProcess& p, std::string* log, const std::string& prefix,
+                            milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+      const auto left =
+          std::chrono::duration_cast<milliseconds>(deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) return false;
+      const auto line = p.read_line(left);
+      if (!line) return false;
+      *log += *line + "\n";
+      if (line->compare(0, prefix.size(), prefix) == 0) return true;
+    }
+  }
+
+  /// Stops the sidecar and returns everything it printed (after what is already in `log`).
+  static std::string finish_sidecar(ChildProcess& p, std::string log = {}) {
+    p.signal(SIGTERM);
+    log += p.read_all(milliseconds(10000));
+    EXPECT_EQ(p.wait_exit(milliseconds(5000)).value_or(-1), 0) << log;
+    return log;
   }
 
   std::string domain_;
   std::string partition_;
 };
 
-bool has_line(const std::string& out, const std::string& pattern) {
-  const std::regex re(pattern);
+/// True if a line of `out` matches `pattern`: text to find in the line, optionally anchored with a
+/// leading '^' (line starts with it) and/or a trailing '$' (line ends with it). (No std::regex: GCC
+/// 12's -Wmaybe-uninitialized false positive in <regex> breaks the -Werror ASan build.)
+bool has_line(const std::string& out, std::string pattern) {
+  const bool at_start = !pattern.empty() && pattern.front() == '^';
+  if (at_start) pattern.erase(0, 1);
+  const bool at_end = !pattern.empty() && pattern.back() == '$';
+  if (at_end) pattern.pop_back();
   std::istringstream in(out);
   std::string line;
   while (std::getline(in, line)) {
-    if (std::regex_search(line, re)) return true;
+    if (at_start && at_end) {
+      if (line == pattern) return true;
+    } else if (at_start) {
+      if (line.compare(0, pattern.size(), pattern) == 0) return true;
+    } else if (at_end) {
+      if (line.size() >= pattern.size() &&
+          line.compare(line.size() - pattern.size(), pattern.size(), pattern) == 0) {
+        return true;
+      }
+    } else if (line.find(pattern) != std::string::npos) {
+      return true;
+    }
   }
   return false;
 }
 
+/// The value of `field` on the peer's "summary ..." line, or -1.
 int summary(const std::string& out, const std::string& field) {
-  std::smatch m;
-  const std::regex re("summary .*" + field + "=(\\d+)");
-  if (!std::regex_search(out, m, re)) return -1;
-  return std::stoi(m[1]);
+  std::istringstream in(out);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, 8, "summary ") != 0) continue;
+    const auto at = line.find(" " + field + "=");
+    if (at == std::string::npos) return -1;
+    return std::atoi(line.c_str() + at + field.size() + 2);
+  }
+  return -1;
 }
 
 /// The control peer of every test: the shore monitor reads the events and acknowledges.
@@ -185,6 +237,7 @@ Peer shore_control() {
   p.read_faults = true;
   p.write_acks = true;
   p.operator_id = "shore-op";
+  p.until_faults = 2;
   return p;
 }
 
@@ -206,14 +259,17 @@ TEST_F(SecurityTest, AuthorisedPeersReadEventsAcknowledgeAndFeedInsSamples) {
   auto shore_p = start_peer(shore_control());
   auto sensors_p = start_peer(sensors);
   const std::string shore = finish_peer(*shore_p);
-  const std::string sensor_out = finish_peer(*sensors_p);
-  const std::string side = finish_sidecar(*sidecar);
+  std::string log;
+  EXPECT_TRUE(wait_for_line(*sidecar, &log, "ins mmsi=257000001 seq=", milliseconds(30000)))
+      << "no INS sample of the authorised sensor gateway reached the sidecar\n"
+      << log;
+  const std::string sensor_out = stop_peer(*sensors_p);
+  const std::string side = finish_sidecar(*sidecar, log);
 
   EXPECT_TRUE(has_line(shore, "^fault_reader created$")) << shore;
   EXPECT_TRUE(has_line(shore, "^ack_writer created$")) << shore;
   EXPECT_TRUE(has_line(sensor_out, "^ins_writer created$")) << sensor_out;
   expect_control_worked(shore, side);
-  EXPECT_TRUE(has_line(side, "^ins mmsi=257000001 seq=\\d+$")) << side;
 }
 
 TEST_F(SecurityTest, ReadOnlyObserverReadsEventsButCannotAcknowledgeOrInject) {
@@ -228,7 +284,8 @@ TEST_F(SecurityTest, ReadOnlyObserverReadsEventsButCannotAcknowledgeOrInject) {
   auto shore_p = start_peer(shore_control());
   auto observer_p = start_peer(observer);
   const std::string shore = finish_peer(*shore_p);
-  const std::string obs = finish_peer(*observer_p);
+  // The observer was up at least as long as the shore, whose acks got through meanwhile.
+  const std::string obs = stop_peer(*observer_p);
   const std::string side = finish_sidecar(*sidecar);
 
   expect_control_worked(shore, side);
@@ -266,7 +323,7 @@ TEST_F(SecurityTest, ParticipantWithoutIdentityCanNeitherReadNorInject) {
   auto shore_p = start_peer(shore_control());
   auto intruder_p = start_peer(intruder(who("", "")));
   const std::string shore = finish_peer(*shore_p);
-  const std::string intr = finish_peer(*intruder_p);
+  const std::string intr = stop_peer(*intruder_p);
   const std::string side = finish_sidecar(*sidecar);
 
   expect_control_worked(shore, side);
@@ -284,7 +341,7 @@ TEST_F(SecurityTest, IdentityFromForeignCaCanNeitherReadNorInject) {
   // permissions: only the CA differs.
   auto intruder_p = start_peer(intruder(who(foreign_profiles(), "shore")));
   const std::string shore = finish_peer(*shore_p);
-  const std::string intr = finish_peer(*intruder_p);
+  const std::string intr = stop_peer(*intruder_p);
   const std::string side = finish_sidecar(*sidecar);
 
   expect_control_worked(shore, side);
@@ -380,6 +437,7 @@ TEST_F(SecurityTest, PayloadsAreEncryptedOnTheWire) {
     Peer reader;
     reader.identity = who("", "");
     reader.read_faults = true;
+    reader.until_faults = 2;
     auto reader_p = start_peer(reader);
     const std::string out = finish_peer(*reader_p);
     finish_sidecar(*plain);
