@@ -61,6 +61,9 @@ Result run(const std::vector<std::string>& argv, milliseconds timeout) {
 class PkiEnvironment : public ::testing::Environment {
  public:
   void SetUp() override {
+#ifdef USV_FDI_LSAN_SUPPRESSIONS  // ASan build: Fast DDS's own leaks (lsan.supp), for the probes
+    ::setenv("LSAN_OPTIONS", "suppressions=" USV_FDI_LSAN_SUPPRESSIONS, 0);
+#endif
     g_pki = fs::path(USV_FDI_SECURITY_WORKDIR) / ("pki-" + std::to_string(::getpid()));
     fs::remove_all(g_pki);
     fs::create_directories(g_pki);
