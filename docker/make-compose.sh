@@ -104,14 +104,16 @@ x-discovery: &discovery
 services:
   discovery0:
     <<: *discovery
-    command: ["--server-id", "0", "--ip-address", "$subnet.2", "--port", "11811"]
+    command: ["--server-id", "0", "--ip-address", "$subnet.2", "--port", "11811",
+              "-x", "usv_fdi_discovery_server_udp@/usr/local/share/usv-fdi/config/qos/fleet_participants.xml"]
     networks:
       fleet:
         ipv4_address: $subnet.2
 
   discovery1:
     <<: *discovery
-    command: ["--server-id", "1", "--ip-address", "$subnet.3", "--port", "11811"]
+    command: ["--server-id", "1", "--ip-address", "$subnet.3", "--port", "11811",
+              "-x", "usv_fdi_discovery_server_udp@/usr/local/share/usv-fdi/config/qos/fleet_participants.xml"]
     networks:
       fleet:
         ipv4_address: $subnet.3

@@ -63,7 +63,7 @@ echo "ok: without a discovery server vessel 2 does not discover vessel 1 (4 s)"
 
 # 2. The discovery server in the shore namespace, on the bridge address.
 fleet_netns_exec "$name" shore fastdds discovery -i 0 -l "$server" -p "$port" \
-  >"$work/server.log" 2>&1 &
+  -x "usv_fdi_discovery_server_udp@$FASTRTPS_DEFAULT_PROFILES_FILE" >"$work/server.log" 2>&1 &
 for _ in $(seq 50); do
   fleet_netns_exec "$name" shore ss -lun 2>/dev/null | grep -q ":$port " && break
   sleep 0.1

@@ -41,7 +41,8 @@ fail() {
 fleet_netns_up "$name" 1 || fail "namespace not made"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$here/../../docker/fleet_participants.xml"
 export ROS_DISCOVERY_SERVER="127.0.0.1:11811"
-fleet_netns_exec "$name" v1 fastdds discovery -i 0 -l 127.0.0.1 -p 11811 >"$work/server.log" 2>&1 &
+fleet_netns_exec "$name" v1 fastdds discovery -i 0 -l 127.0.0.1 -p 11811 \
+  -x "usv_fdi_discovery_server_udp@$FASTRTPS_DEFAULT_PROFILES_FILE" >"$work/server.log" 2>&1 &
 
 # start_publisher PROFILE DOMAIN: 2 latched instances, in the vessel namespace, shared /dev/shm.
 start_publisher() {
