@@ -228,6 +228,7 @@ class Loader {
         {"c_min", num(&is.c_min)},
         {"c_margin", num(&is.c_margin)},
         {"resume_time", num(&is.resume_time)},
+        {"resume_after_fault", num(&is.resume_after_fault)},
         {"stale_timeout", num(&is.stale_timeout)},
         {"stuck_time", num(&is.stuck_time)},
         {"stuck_min_samples", integ(&is.stuck_min_samples)},
