@@ -75,7 +75,7 @@ struct IdentificationParams {
   double gamma = 1.0;       ///< adaptation gain: [1/s] normalised, [1/(psi^2 s)] paper law
   bool normalised = true;   ///< false: the paper's law a' = gamma psi (h - psi a)
   double mu = 1e-8;         ///< normaliser of the normalised law, in excitation^2 (> 0)
-  double lambda = 0.01;     ///< Kreisselmeier forgetting rate [1/s] (100 s memory)
+  double lambda = 0.005;    ///< Kreisselmeier forgetting rate [1/s] (200 s memory)
   double warmup_time = -1;  ///< filter warm-up before regressions are used [s]; <0: 10/min(eps)
   double max_gap = 1.0;     ///< a time gap longer than this restarts the filters [s]
   bool curvature_correction = true;  ///< filter the inputs' curvature too (O(h^3) error)
