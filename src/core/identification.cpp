@@ -196,10 +196,11 @@ bool Identifier::update(const Sample& s, bool freeze) {
     for (Batch& b : open_) {
       b.T += dt;
       if (b.T <= 0.0) continue;  // the second window has not begun yet
-      const double h = std::sin(M_PI * std::min(1.0, b.T / T_b));
-      b.P += h * h * dt * (z_ * q_.transpose());
-      b.G += h * h * dt * (z_ * m_.transpose());
-      b.H2 += std::pow(h, 4) * dt;
+      const double sn = std::sin(M_PI * std::min(1.0, b.T / T_b));
+      const double w = sn * sn;  // Hann window
+      b.P += w * dt * (z_ * q_.transpose());
+      b.G += w * dt * (z_ * m_.transpose());
+      b.H2 += w * w * dt;
       if (b.T >= T_b) {
         batches_[head_] = b;
         head_ = (head_ + 1) % kBatches;

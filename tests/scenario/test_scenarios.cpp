@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <string>
@@ -148,6 +150,56 @@ TEST_P(BiasDelay, MedianDetectionDelayOfATenSigmaBiasIsUnderOneSecond) {
   EXPECT_TRUE(false_alarms(sim, r).empty());
 }
 INSTANTIATE_TEST_SUITE_P(Vessels, BiasDelay, kCases, case_name);
+
+class SeedSweep : public testing::TestWithParam<Case> {};
+
+TEST_P(SeedSweep, EightMoreSeedsOfHealthyAndEveryKindVoyages) {
+  // GIVEN eight seeds other than the tests' own, per vessel and rate: 30 minutes of healthy
+  //   data after arming, and the every-kind voyage
+  const Case c = GetParam();
+  const VesselModel v = vessel(c.vessel);
+  int faults = 0, detected = 0, isolated = 0, false_raises = 0;
+  double hours = 0.0;
+  for (std::uint64_t seed = 1001; seed <= 1008; ++seed) {
+    SimConfig healthy;
+    healthy.vessel = v;
+    healthy.rate_hz = c.rate_hz;
+    healthy.seed = seed;
+    healthy.duration = first_fault(c.vessel) + 1800.0;
+    SimConfig faulty = healthy;
+    faulty.faults = every_kind(v, first_fault(c.vessel), 30.0, 60.0);
+    faulty.duration = faulty.faults.back().t_end + 60.0;
+    // WHEN the engine processes each
+    const RunResult h = run(healthy, vessel_config(c.vessel));
+    const RunResult f = run(faulty, vessel_config(c.vessel));
+    ASSERT_FALSE(std::isnan(h.t_armed)) << "seed " << seed;
+    ASSERT_LT(f.t_armed, first_fault(c.vessel)) << "seed " << seed;
+    for (const FaultEvent& e : h.events) false_raises += e.state == FaultState::kRaised;
+    false_raises += static_cast<int>(false_alarms(faulty, f).size());
+    hours += (healthy.duration - h.t_armed + faulty.duration - f.t_armed) / 3600.0;
+    for (const FaultScore& s : score(faulty, f)) {
+      ++faults;
+      detected += s.detected;
+      isolated += s.detected && s.isolated;
+      if (!(s.detected && s.isolated)) {
+        std::printf("[ sweep    ] seed %llu: %s %s at %g %s\n",
+                    static_cast<unsigned long long>(seed), to_string(s.fault.sensor),
+                    to_string(s.fault.kind), s.fault.t_start,
+                    s.detected ? "named the wrong sensor" : "missed");
+      }
+    }
+  }
+  std::printf(
+      "[ sweep    ] %s %g Hz: %d of %d faults detected, %d isolated; %d false raises in "
+      "%.1f h\n",
+      c.vessel.c_str(), c.rate_hz, detected, faults, isolated, false_raises, hours);
+  // THEN every fault is detected, at most one in a hundred is put on the wrong sensor, and
+  //   at most one raise in the ~8 h is false
+  EXPECT_EQ(detected, faults);
+  EXPECT_GE(isolated, faults - faults / 100);
+  EXPECT_LE(false_raises, 1);
+}
+INSTANTIATE_TEST_SUITE_P(Vessels, SeedSweep, kCases, case_name);
 
 TEST(PaperScenario, BothFaultsAreDetectedIsolatedAndTheEstimateConvergesMonotonically) {
   // GIVEN the paper's scenario on the Otter (noise-free, as the paper's Simulink model):

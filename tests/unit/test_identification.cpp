@@ -514,6 +514,41 @@ TEST(ErrorsInVariables, LeastSquaresShrinksAInProportionToTheSampleIntervalRudde
   EXPECT_LT(std::abs(iv10), 0.25 * std::abs(ls10));
 }
 
+TEST(StandardError, IsCalibratedOnNoisyData) {
+  Mat2 A;
+  A << -0.883024, -0.438614, -1.55172, -1.16124;
+  const Vec2 B(0.165394, -2.19400);
+  const Vec4 a = to_params(A);
+  for (const double rate : {10.0, 50.0}) {
+    // GIVEN the Otter under a smooth rudder with 3x its realistic sensor noise, 32 seeds
+    std::vector<double> z;
+    for (int seed = 0; seed < 32; ++seed) {
+      const NoisyRun run = otter_sines(rate, 400.0, 0.015, 0.0015, 900 + seed);
+      Identifier id(IdentificationParams{}, B);
+      // WHEN it is identified
+      for (const Sample& smp : run.noisy) ASSERT_TRUE(id.update(smp, false));
+      // THEN every a_n has a finite standard error, and the errors in units of it look
+      //   like standard normal draws: median |z| near 0.67, 2 standard errors cover ~95 %
+      const Vec4 se = id.estimate().std_error;
+      ASSERT_TRUE(se.allFinite()) << rate << " Hz seed " << seed;
+      const Vec4 e = to_params(id.estimate().A) - a;
+      for (int n = 0; n < 4; ++n) {
+        ASSERT_GT(se(n), 0.0);
+        z.push_back(std::abs(e(n)) / se(n));
+      }
+    }
+    std::sort(z.begin(), z.end());
+    const double med = z[z.size() / 2];
+    const double within2 =
+        static_cast<double>(std::lower_bound(z.begin(), z.end(), 2.0) - z.begin()) / z.size();
+    std::cout << "[ INFO     ] " << rate << " Hz: |error| / standard error: median " << med
+              << ", within 2: " << within2 << "\n";
+    EXPECT_GT(med, 0.67 / 2.0);
+    EXPECT_LT(med, 0.67 * 2.0);
+    EXPECT_GT(within2, 0.8);
+  }
+}
+
 // Identifier::update once compared s.t with the last *unfrozen* sample, so after a freeze a
 // sample older than the last frozen one was accepted and estimate().t went back.
 TEST(Identifier, TimeMustIncreaseAcrossFrozenSamplesToo) {
