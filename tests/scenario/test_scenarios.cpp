@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "scenario_util.hpp"
 #include "usv_fdi/io/config.hpp"
@@ -200,6 +202,83 @@ TEST_P(SeedSweep, EightMoreSeedsOfHealthyAndEveryKindVoyages) {
   EXPECT_LE(false_raises, 1);
 }
 INSTANTIATE_TEST_SUITE_P(Vessels, SeedSweep, kCases, case_name);
+
+// The same over many seeds, for the figures of merit (opt-in, ~2 min on one core):
+//   [USV_FDI_SWEEP_SEEDS=101-300, the default] build/tests/usv_fdi_scenario_tests
+//     --gtest_also_run_disabled_tests --gtest_filter='*DISABLED_ManySeeds*'
+TEST(SeedSweep, DISABLED_ManySeeds) {
+  std::uint64_t s0 = 101, s1 = 300;
+  if (const char* env = std::getenv("USV_FDI_SWEEP_SEEDS")) {
+    unsigned long long a = 0, b = 0;
+    ASSERT_EQ(std::sscanf(env, "%llu-%llu", &a, &b), 2) << "USV_FDI_SWEEP_SEEDS=" << env;
+    s0 = a;
+    s1 = b;
+  }
+  for (const Case& c :
+       {Case{"otter", 50.0}, Case{"otter", 10.0}, Case{"mariner", 50.0}, Case{"mariner", 10.0}}) {
+    const VesselModel v = vessel(c.vessel);
+    const EngineConfig cfg = vessel_config(c.vessel);
+    int faults = 0, detected = 0, isolated = 0, biases = 0, bias_ok = 0;
+    int raises_healthy = 0, fa_every = 0, fa_bias = 0;
+    double h_healthy = 0, h_every = 0, h_bias = 0;
+    std::vector<double> delays;
+    for (std::uint64_t seed = s0; seed <= s1; ++seed) {
+      SimConfig sim;
+      sim.vessel = v;
+      sim.rate_hz = c.rate_hz;
+      sim.seed = seed;
+      // 30 minutes of healthy data after the first-fault time
+      sim.duration = first_fault(c.vessel) + 1800.0;
+      const RunResult h = run(sim, cfg);
+      ASSERT_FALSE(std::isnan(h.t_armed));
+      for (const FaultEvent& e : h.events) raises_healthy += e.state == FaultState::kRaised;
+      h_healthy += (sim.duration - h.t_armed) / 3600.0;
+      // one fault of every kind on each sensor
+      sim.faults = every_kind(v, first_fault(c.vessel), 30.0, 60.0);
+      sim.duration = sim.faults.back().t_end + 60.0;
+      const RunResult f = run(sim, cfg);
+      for (const FaultScore& s : score(sim, f)) {
+        ++faults;
+        detected += s.detected;
+        isolated += s.detected && s.isolated;
+      }
+      fa_every += static_cast<int>(false_alarms(sim, f).size());
+      h_every += (sim.duration - f.t_armed) / 3600.0;
+      // twelve 10-sigma biases
+      sim.faults.clear();
+      double t = first_fault(c.vessel);
+      for (int i = 0; i < 12; ++i) {
+        const Sensor sn = i % 2 ? Sensor::kGyro : Sensor::kAccelerometer;
+        const double sigma = sn == Sensor::kGyro ? v.sigma_r : v.sigma_v;
+        sim.faults.push_back(
+            {sn, FaultKind::kBias, t, t + 20.0, (i % 4 < 2 ? 10.0 : -10.0) * sigma});
+        t += 57.0;
+      }
+      sim.duration = t + 30.0;
+      const RunResult b = run(sim, cfg);
+      for (const FaultScore& s : score(sim, b)) {
+        ++biases;
+        bias_ok += s.detected && s.isolated;
+        if (s.detected) delays.push_back(s.delay);
+      }
+      fa_bias += static_cast<int>(false_alarms(sim, b).size());
+      h_bias += (sim.duration - b.t_armed) / 3600.0;
+    }
+    const int fa = raises_healthy + fa_every + fa_bias;
+    const double hours = h_healthy + h_every + h_bias;
+    std::printf(
+        "[ sweep    ] %s %g Hz, seeds %llu-%llu: healthy %d raises in %.1f h; every kind "
+        "%d/%d detected, %d/%d isolated, %d false in %.1f h; 10-sigma biases %d/%d "
+        "isolated, median delay %.3f s, %d false in %.1f h; false alarms %.3f /h\n",
+        c.vessel.c_str(), c.rate_hz, static_cast<unsigned long long>(s0),
+        static_cast<unsigned long long>(s1), raises_healthy, h_healthy, detected, faults, isolated,
+        faults, fa_every, h_every, bias_ok, biases, median(delays), fa_bias, h_bias, fa / hours);
+    EXPECT_EQ(detected, faults) << c.vessel << " " << c.rate_hz;
+    EXPECT_GE(isolated, faults - faults / 200) << c.vessel << " " << c.rate_hz;
+    EXPECT_LT(median(delays), 1.0) << c.vessel << " " << c.rate_hz;
+    EXPECT_LT(fa / hours, 0.1) << c.vessel << " " << c.rate_hz;
+  }
+}
 
 TEST(NoiseFree, EveryShippedVesselsAIsFoundToOneInTenThousandAtTenFiftyAndHundredHertz) {
   for (const std::string name : {"otter", "mariner"}) {
