@@ -72,6 +72,7 @@ void IsolationParams::validate() const {
   require(c_min > 0 && c_min <= 1, "c_min", c_min, "must lie in (0, 1]");
   require(c_margin >= 0 && c_margin < 1, "c_margin", c_margin, "must lie in [0, 1)");
   require(resume_time >= 0, "resume_time", resume_time, "must be >= 0");
+  require(resume_after_fault >= 0, "resume_after_fault", resume_after_fault, "must be >= 0");
   require(stale_timeout > 0, "stale_timeout", stale_timeout, "must be > 0");
   require(stuck_time > 0, "stuck_time", stuck_time, "must be > 0");
   require(stuck_min_samples >= 2, "stuck_min_samples", stuck_min_samples, "must be >= 2");
@@ -101,15 +102,12 @@ void Isolator::Window::push(double x, std::size_t n) {
 Isolator::Isolator(const IsolationParams& params, const Vec2& B) : p_(params), B_(B) {
   p_.validate();
   if (!B.allFinite()) throw std::invalid_argument("model.B must be finite");
-  obs_v_.set_channel(kV);
-  obs_g_.set_channel(kR);
   scales_configured_ = p_.sigma_v > 0;
-  floor_s_ = floor_d_ = Vec2(p_.sigma_floor_v, p_.sigma_floor_r);
   const double pmin = std::min(p_.poles_v.cwiseAbs().minCoeff(), p_.poles_g.cwiseAbs().minCoeff());
   settle_time_ = p_.settle_time >= 0 ? p_.settle_time : 3.0 / pmin;
 }
 
-bool Isolator::design(const Mat2& A) {
+bool Isolator::design(const Mat2& A, Bank* b) {
   const double sv = scales_configured_ ? p_.sigma_v : 10.0 * p_.sigma_floor_v;
   const double sr = scales_configured_ ? p_.sigma_r : 10.0 * p_.sigma_floor_r;
   const ObserverDesign dv =
@@ -121,29 +119,57 @@ bool Isolator::design(const Mat2& A) {
     return false;
   }
   st_.observer_problem.clear();
-  obs_v_.set_design(dv, B_);
-  obs_g_.set_design(dg, B_);
-  st_.A_design = A;
-  st_.k_v = dv.k;
-  st_.k_g = dg.k;
-  theory_scales_pending_ = scales_configured_;
+  *b = Bank{};
+  b->v.set_channel(kV);
+  b->g.set_channel(kR);
+  b->v.set_design(dv, B_);
+  b->g.set_design(dg, B_);
+  b->A = A;
+  b->k_v = dv.k;
+  b->k_g = dg.k;
+  b->floor_s = b->floor_d = Vec2(p_.sigma_floor_v, p_.sigma_floor_r);
+  b->theory_scales_pending = scales_configured_;
   return true;
 }
 
+void Isolator::publish_bank() {
+  st_.A_design = act_.A;
+  st_.k_v = act_.k_v;
+  st_.k_g = act_.k_g;
+  st_.sigma_s = act_.sigma_s;
+  st_.sigma_d = act_.sigma_d;
+  st_.thresholds = act_.threshold;
+  st_.thresholds_d = act_.threshold_d;
+  st_.threshold = act_.threshold.maxCoeff();
+  st_.threshold_d = act_.threshold_d.maxCoeff();
+  st_.relearning = has_shadow_;
+}
+
 void Isolator::set_estimate(const Estimate& est) {
+  const double t_now = have_prev_ ? prev_.t : est.t;
   if (!st_.armed) {
     if (!est.converged) return;
-    if (!design(est.A)) return;
+    if (!design(est.A, &act_)) return;
     st_.armed = true;
-    t_armed_ = have_prev_ ? prev_.t : est.t;
-    settle_until_ = t_armed_ + settle_time_;
+    ++st_.designs;
+    t_armed_ = t_now;
+    act_.settle_until = t_armed_ + settle_time_;
     const Vec2 y0(std::isfinite(prev_.v) ? prev_.v : 0.0, std::isfinite(prev_.r) ? prev_.r : 0.0);
-    obs_v_.reset(y0);
-    obs_g_.reset(y0);
+    act_.v.reset(y0);
+    act_.g.reset(y0);
+    publish_bank();
     return;
   }
-  const double ref = st_.A_design.norm();
-  if ((est.A - st_.A_design).norm() > p_.redesign_tolerance * ref) design(est.A);
+  // One redesign learns at a time; the design in force keeps detecting meanwhile.
+  if (has_shadow_) return;
+  const double ref = act_.A.norm();
+  if (!((est.A - act_.A).norm() > p_.redesign_tolerance * ref)) return;
+  if (!design(est.A, &shadow_)) return;
+  shadow_.v.reset(act_.v.x());
+  shadow_.g.reset(act_.g.x());
+  shadow_.settle_until = t_now + settle_time_;
+  has_shadow_ = true;
+  st_.relearning = true;
 }
 
 double Isolator::learned_threshold(std::vector<double>* healthy) const {
@@ -168,7 +194,7 @@ Detection Isolator::make_detection(Sensor sensor, bool active, FaultKind kind, d
   d.kind = kind;
   d.c_a = st_.c_a;
   d.c_g = st_.c_g;
-  d.threshold = st_.threshold;
+  d.threshold = sensor == Sensor::kUnknown ? st_.threshold : st_.thresholds(sensor_index(sensor));
   if (sensor == Sensor::kAccelerometer) {
     d.statistic = active ? st_.J(0) : st_.D(0);
   } else if (sensor == Sensor::kGyro) {
@@ -197,6 +223,7 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
     out->push_back(d);
   } else if (before != 0 && c.sources == 0) {
     c.active = false;
+    if (sensor != Sensor::kUnknown) resync_[sensor_index(sensor)] = true;
     Detection d = make_detection(sensor, false, c.kind, t);
     d.message = message;
     out->push_back(d);
@@ -230,13 +257,16 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   // Freeze identification while anything is suspect, and for resume_time after.
   bool suspect = !st_.input.v_ok || !st_.input.r_ok || !st_.input.delta_ok || !std::isfinite(s.v) ||
                  !std::isfinite(s.r) || !std::isfinite(s.delta);
-  for (const Condition& c : cond_) suspect = suspect || c.active;
+  bool faulty = false;
+  for (const Condition& c : cond_) faulty = faulty || c.active;
+  suspect = suspect || faulty;
+  if (faulty) t_last_fault_ = s.t;
   if (st_.armed && !st_.learning && !st_.settling) {
-    suspect = suspect || st_.J.maxCoeff() > p_.exit_ratio * st_.threshold ||
-              st_.D.maxCoeff() > p_.exit_ratio * st_.threshold_d;
+    suspect = suspect || (st_.J.array() > p_.exit_ratio * st_.thresholds.array()).any() ||
+              (st_.D.array() > p_.exit_ratio * st_.thresholds_d.array()).any();
   }
   if (suspect) t_last_suspect_ = s.t;
-  freeze_ = s.t - t_last_suspect_ < p_.resume_time;
+  freeze_ = s.t - t_last_suspect_ < p_.resume_time || s.t - t_last_fault_ < p_.resume_after_fault;
   prev_ = s;
   have_prev_ = true;
   return true;
@@ -312,117 +342,184 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
   }
 }
 
-void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection>* out) {
-  if (!obs_v_.ready() || !obs_g_.ready()) return;
+void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok) {
   const auto usable = [&](double x, double lim) { return std::isfinite(x) && std::abs(x) <= lim; };
-  const bool v_ok = usable(s.v, p_.max_abs_v);
-  const bool r_ok = usable(s.r, p_.max_abs_r);
-  // Propagate the observers over [t_{k-1}, t_k] with the previous inputs held.
-  if (have_prev_ && dt > 0) {
-    if (dt > p_.stale_timeout) {
-      // A gap: restart the observers from the measurements and let them settle again.
-      const Vec2 y0(v_ok ? s.v : obs_v_.x()(0), r_ok ? s.r : obs_g_.x()(1));
-      obs_v_.reset(y0);
-      obs_g_.reset(y0);
-      settle_until_ = s.t + settle_time_;
-    } else {
-      const double d = usable(prev_.delta, p_.max_abs_delta) ? prev_.delta
-                       : std::isfinite(last_delta_)          ? last_delta_
-                                                             : 0.0;
-      // While a sensor is faulty, its dedicated observer is driven by the other observer's
-      // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
-      // the fault stays fully visible and the residual is clean the moment the fault ends.
-      const bool fa = cond_[0].active, fg = cond_[1].active;
-      const bool pv = usable(prev_.v, p_.max_abs_v) && !fa;
-      const bool pr = usable(prev_.r, p_.max_abs_r) && !fg;
-      const double yv = pv ? prev_.v : obs_g_.x()(0);
-      const double yr = pr ? prev_.r : obs_v_.x()(1);
-      const bool use_v = pv || (fa && !fg);
-      const bool use_r = pr || (fg && !fa);
-      obs_v_.step(dt, d, yv, use_v);
-      obs_g_.step(dt, d, yr, use_r);
-    }
+  if (dt > p_.stale_timeout) {
+    // A gap: restart the observers from the measurements and let them settle again.
+    const Vec2 y0(v_ok ? s.v : b->v.x()(0), r_ok ? s.r : b->g.x()(1));
+    b->v.reset(y0);
+    b->g.reset(y0);
+    b->settle_until = s.t + settle_time_;
+    return;
   }
-  st_.settling = s.t < settle_until_;
-  if (st_.settling || !(dt > 0) || !st_.input.delta_ok) return;
+  const double d = usable(prev_.delta, p_.max_abs_delta) ? prev_.delta
+                   : std::isfinite(last_delta_)          ? last_delta_
+                                                         : 0.0;
+  const double d_new = usable(s.delta, p_.max_abs_delta) ? s.delta : d;
+  // While a sensor is faulty, its dedicated observer is driven by the other observer's
+  // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
+  // the fault stays fully visible and the residual is clean the moment the fault ends.
+  const bool fa = cond_[0].active, fg = cond_[1].active;
+  const bool pv = usable(prev_.v, p_.max_abs_v) && !fa;
+  const bool pr = usable(prev_.r, p_.max_abs_r) && !fg;
+  const double yv = pv ? prev_.v : b->g.x()(0);
+  const double yr = pr ? prev_.r : b->v.x()(1);
+  const bool use_v = pv || (fa && !fg);
+  const bool use_r = pr || (fg && !fa);
+  b->v.step(dt, d, d_new, yv, use_v);
+  b->g.step(dt, d, d_new, yr, use_r);
+}
 
-  if (theory_scales_pending_) {
+bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
+                        double raw[4], Vec2* sw) {
+  *sw = Vec2(kNaN, kNaN);
+  if (s.t < b->settle_until) return false;
+  if (b->theory_scales_pending) {
     // Innovation variance = sensor noise + observer error driven by the driving sensor.
     Mat2 Pv, Pg;
-    const bool okv = discrete_lyapunov(obs_v_.Ad(), obs_v_.Gy(), &Pv);
-    const bool okg = discrete_lyapunov(obs_g_.Ad(), obs_g_.Gy(), &Pg);
+    const bool okv = discrete_lyapunov(b->v.Ad(), b->v.Gy(), &Pv);
+    const bool okg = discrete_lyapunov(b->g.Ad(), b->g.Gy(), &Pg);
     if (okv && okg) {
       const double sv2 = p_.sigma_v * p_.sigma_v, sr2 = p_.sigma_r * p_.sigma_r;
       // Floors for the learned scales: what sensor noise alone would give.
-      floor_s_ = Vec2(std::sqrt(sv2 + sv2 * Pv(0, 0)), std::sqrt(sr2 + sr2 * Pg(1, 1)));
-      floor_d_ = Vec2(std::sqrt(sv2 + sr2 * Pg(0, 0)), std::sqrt(sr2 + sv2 * Pv(1, 1)));
+      b->floor_s = Vec2(std::sqrt(sv2 + sv2 * Pv(0, 0)), std::sqrt(sr2 + sr2 * Pg(1, 1)));
+      b->floor_d = Vec2(std::sqrt(sv2 + sr2 * Pg(0, 0)), std::sqrt(sr2 + sv2 * Pv(1, 1)));
     }
-    theory_scales_pending_ = false;
+    b->theory_scales_pending = false;
   }
+  raw[0] = v_ok ? s.v - b->v.x()(0) : kNaN;
+  raw[1] = r_ok ? s.r - b->g.x()(1) : kNaN;
+  raw[2] = v_ok ? s.v - b->g.x()(0) : kNaN;
+  raw[3] = r_ok ? s.r - b->v.x()(1) : kNaN;
 
-  const double raw[4] = {v_ok ? s.v - obs_v_.x()(0) : kNaN, r_ok ? s.r - obs_g_.x()(1) : kNaN,
-                         v_ok ? s.v - obs_g_.x()(0) : kNaN, r_ok ? s.r - obs_v_.x()(1) : kNaN};
-
-  // Learning: first half scales, second half the healthy distribution of J_N.
-  const double t_learn0 = t_armed_ + settle_time_;
-  st_.learning = !scales_learned_;
-  if (!scales_learned_) {
-    if (s.t - t_learn0 < 0.5 * p_.learn_time) {
-      if (v_ok && r_ok) {
-        for (int i = 0; i < 4; ++i) learn_raw_[i].push_back(raw[i]);
-      }
-      return;
+  // Learning, on healthy data only: first half scales, second half the distribution of J_N.
+  if (!b->scales_learned) {
+    if (learn_ok) {
+      for (int i = 0; i < 4; ++i) b->learn_raw[i].push_back(raw[i]);
+      b->learned_time += dt;
     }
-    if (st_.sigma_s(0) == 0.0) {
-      st_.sigma_s(0) = std::max(robust_std(&learn_raw_[0]), floor_s_(0));
-      st_.sigma_s(1) = std::max(robust_std(&learn_raw_[1]), floor_s_(1));
-      st_.sigma_d(0) = std::max(robust_std(&learn_raw_[2]), floor_d_(0));
-      st_.sigma_d(1) = std::max(robust_std(&learn_raw_[3]), floor_d_(1));
-      for (auto& v : learn_raw_) std::vector<double>().swap(v);
-    }
+    if (b->learned_time < 0.5 * p_.learn_time) return true;
+    b->sigma_s(0) = std::max(robust_std(&b->learn_raw[0]), b->floor_s(0));
+    b->sigma_s(1) = std::max(robust_std(&b->learn_raw[1]), b->floor_s(1));
+    b->sigma_d(0) = std::max(robust_std(&b->learn_raw[2]), b->floor_d(0));
+    b->sigma_d(1) = std::max(robust_std(&b->learn_raw[3]), b->floor_d(1));
+    for (auto& v : b->learn_raw) std::vector<double>().swap(v);
+    b->scales_learned = true;
+    b->learned_time = 0.0;
   }
 
   const std::size_t n = window_samples(dt);
   const double c2 = p_.clip * p_.clip;
-  Vec2 sw(kNaN, kNaN);
   for (int c = 0; c < 2; ++c) {
     if (!std::isfinite(raw[c])) continue;
-    sw(c) = raw[c] / st_.sigma_s(c);
-    const double dw = raw[2 + c] / st_.sigma_d(c);
-    win_s_[c].push(std::min(sw(c) * sw(c), c2), n);
-    win_sl_[c].push(sw(c), n);
-    win_d_[c].push(std::min(dw * dw, c2), n);
+    (*sw)(c) = raw[c] / b->sigma_s(c);
+    const double dw = raw[2 + c] / b->sigma_d(c);
+    b->win_s[c].push(std::min((*sw)(c) * (*sw)(c), c2), n);
+    b->win_sl[c].push((*sw)(c), n);
+    b->win_d[c].push(std::min(dw * dw, c2), n);
+  }
+  b->J = Vec2(b->win_s[0].mean(), b->win_s[1].mean());
+  b->D = Vec2(b->win_d[0].mean(), b->win_d[1].mean());
+
+  if (!b->learned) {
+    if (learn_ok && b->win_s[0].v.size() >= n && b->win_s[1].v.size() >= n) {
+      for (int c = 0; c < 2; ++c) {
+        b->learn_J[c].push_back(b->J(c));
+        b->learn_D[c].push_back(b->D(c));
+      }
+      b->learned_time += dt;
+    }
+    if (b->learned_time >= 0.5 * p_.learn_time) {
+      for (int c = 0; c < 2; ++c) {
+        b->threshold(c) = learned_threshold(&b->learn_J[c]);
+        b->threshold_d(c) = learned_threshold(&b->learn_D[c]);
+        std::vector<double>().swap(b->learn_J[c]);
+        std::vector<double>().swap(b->learn_D[c]);
+      }
+      b->learned = true;
+    }
+  }
+  return true;
+}
+
+void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection>* out) {
+  if (!act_.v.ready() || !act_.g.ready()) return;
+  const auto usable = [&](double x, double lim) { return std::isfinite(x) && std::abs(x) <= lim; };
+  const bool v_ok = usable(s.v, p_.max_abs_v);
+  const bool r_ok = usable(s.r, p_.max_abs_r);
+  // Propagate the observers over [t_{k-1}, t_k]: the rudder linear between its samples, the
+  // driving measurements those of t_{k-1}.
+  if (have_prev_ && dt > 0) {
+    propagate(&act_, s, dt, v_ok, r_ok);
+    if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok);
+  }
+  // A sensor whose fault cleared drives its dedicated observer again. While it was faulty
+  // that observer followed the other observer's estimate of the channel, whose error is the
+  // cross residual's (several times the structured one's): restart it from the measurement
+  // and the healthy observer's state, and its evaluation windows from empty (they hold the
+  // faulty period), or the first healthy seconds would look like a new fault. The restarted
+  // observer has its own transient (the other channel's state it is given carries that
+  // observer's error, which the coupling turns into a drift of this channel's prediction):
+  // the channel may raise again once it has settled (settle_time) and its window is full.
+  for (int c = 0; c < 2; ++c) {
+    const double y = c == kV ? s.v : s.r;
+    if (!resync_[c] || !(c == kV ? v_ok : r_ok)) continue;
+    for (Bank* b : {&act_, &shadow_}) {
+      // The other channel's state from the healthy observer (the reconfigured one inferred
+      // it from the cross estimate, through the coupling a2 or a3), this one measured.
+      DedicatedObserver& o = c == kV ? b->v : b->g;
+      const DedicatedObserver& healthy = c == kV ? b->g : b->v;
+      Vec2 x = healthy.x();
+      x(c) = y;
+      o.reset(x);
+      for (auto* w : {&b->win_s[c], &b->win_sl[c], &b->win_d[c]}) *w = Window{};
+    }
+    resync_[c] = false;
+    resettle_until_[c] = s.t + settle_time_;
+  }
+  // Healthy data for learning: both channels usable, and no fault condition raised now or
+  // within resume_after_fault (a fault that hides with the signal clears and re-raises).
+  bool faulty = false;
+  for (const Condition& c : cond_) faulty = faulty || c.active;
+  const bool learn_ok = v_ok && r_ok && !faulty && s.t - t_last_fault_ >= p_.resume_after_fault;
+  double raw[4];
+  Vec2 sw;
+  bool swapped = false;
+  if (has_shadow_ && dt > 0 && st_.input.delta_ok) {
+    evaluate(&shadow_, s, dt, learn_ok, v_ok, r_ok, raw, &sw);
+    if (shadow_.learned) {
+      swapped = true;  // this sample is already in its windows
+      // The redesign has learned its own statistics: it takes over.
+      act_ = std::move(shadow_);
+      shadow_ = Bank{};
+      has_shadow_ = false;
+      ++st_.designs;
+      publish_bank();
+    }
+  }
+  st_.settling = s.t < act_.settle_until;
+  if (st_.settling || !(dt > 0) || !st_.input.delta_ok) return;
+
+  if (!swapped) evaluate(&act_, s, dt, learn_ok, v_ok, r_ok, raw, &sw);
+  st_.learning = !act_.learned;
+  if (!act_.scales_learned) return;
+  publish_bank();
+  for (int c = 0; c < 2; ++c) {
+    if (!std::isfinite(sw(c))) continue;
     hist_s_[c].emplace_back(s.t, sw(c));
     hist_d_[c].emplace_back(s.t, raw[2 + c]);
-    hist_x_[c].emplace_back(s.t, c == kV ? obs_g_.x()(0) : obs_v_.x()(1));
+    hist_x_[c].emplace_back(s.t, c == kV ? act_.g.x()(0) : act_.v.x()(1));
     prune(&hist_s_[c], s.t - p_.classify_window);
     prune(&hist_d_[c], s.t - p_.classify_window);
     prune(&hist_x_[c], s.t - p_.classify_window);
   }
-  st_.J = Vec2(win_s_[0].mean(), win_s_[1].mean());
-  st_.D = Vec2(win_d_[0].mean(), win_d_[1].mean());
+  st_.J = act_.J;
+  st_.D = act_.D;
   const Vec2 e(std::sqrt(std::max(0.0, st_.J(0) - 1.0)), std::sqrt(std::max(0.0, st_.J(1) - 1.0)));
   const double en = e.norm();
   st_.c_a = en > 0 ? e(0) / en : 0.0;
   st_.c_g = en > 0 ? e(1) / en : 0.0;
-
-  if (!scales_learned_) {
-    if (win_s_[0].v.size() >= n && win_s_[1].v.size() >= n) {
-      for (int c = 0; c < 2; ++c) {
-        learn_J_.push_back(st_.J(c));
-        learn_D_.push_back(st_.D(c));
-      }
-    }
-    if (s.t - t_learn0 >= p_.learn_time) {
-      st_.threshold = learned_threshold(&learn_J_);
-      st_.threshold_d = learned_threshold(&learn_D_);
-      std::vector<double>().swap(learn_J_);
-      std::vector<double>().swap(learn_D_);
-      scales_learned_ = true;
-      st_.learning = false;
-    }
-    return;
-  }
+  if (!act_.learned) return;
 
   // Spikes: runs of one or two outliers.
   for (int c = 0; c < 2; ++c) {
@@ -457,16 +554,22 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     }
   }
 
-  // Residual evaluation with hysteresis.
-  const double thr = st_.threshold, thr_exit = p_.exit_ratio * st_.threshold;
-  const double thr_exit_d = p_.exit_ratio * st_.threshold_d;
+  // Residual evaluation with hysteresis, each channel against its own thresholds.
+  const Vec2 thr = st_.thresholds;
+  const std::size_t n_full = window_samples(dt);
+  Vec2 ratio = st_.J.cwiseQuotient(thr);  // > 1: above the enter threshold
+  for (int c = 0; c < 2; ++c) {
+    // refilling or settling after a fault cleared
+    if (act_.win_s[c].v.size() < n_full || s.t < resettle_until_[c]) ratio(c) = 0.0;
+  }
+  const Vec2 thr_exit_d = p_.exit_ratio * st_.thresholds_d;
   const double eps_t = 1e-9;
   const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual,
              u_res = cond_[2].sources & kResidual;
   // Candidate raise.
   int candidate = -1;
   if (!a_res && !g_res && !u_res) {
-    if (st_.J.maxCoeff() > thr) {
+    if (ratio.maxCoeff() > 1.0) {
       if (st_.c_a >= p_.c_min && st_.c_a - st_.c_g >= p_.c_margin) {
         candidate = 0;
       } else if (st_.c_g >= p_.c_min && st_.c_g - st_.c_a >= p_.c_margin) {
@@ -478,8 +581,8 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   } else if (!u_res) {
     // One sensor already raised: the other raises on its own channel (structured residual
     // entries are blind to each other's faults).
-    if (a_res && !g_res && st_.J(1) > thr) candidate = 1;
-    if (g_res && !a_res && st_.J(0) > thr) candidate = 0;
+    if (a_res && !g_res && ratio(1) > 1.0) candidate = 1;
+    if (g_res && !a_res && ratio(0) > 1.0) candidate = 0;
   }
   for (int k = 0; k < 3; ++k) {
     if (k == candidate) {
@@ -488,11 +591,13 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
         const Sensor sensor = static_cast<Sensor>(k);
         const FaultKind kind = k < 2 ? classify(k) : FaultKind::kUnknown;
         if (k < 2) refine_at_[k] = s.t + 0.5 * p_.classify_window;
+        int c_max = 0;
+        ratio.maxCoeff(&c_max);
         std::string msg =
             k < 2 ? std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
-                        " channel: J_N " + std::to_string(st_.J(k)) + " > " + std::to_string(thr)
-                  : "residual on both channels, not isolated: J_N " +
-                        std::to_string(st_.J.maxCoeff()) + " > " + std::to_string(thr);
+                        " channel: J_N " + std::to_string(st_.J(k)) + " > " + std::to_string(thr(k))
+                  : "residual on both channels, not isolated: J_N " + std::to_string(st_.J(c_max)) +
+                        " > " + std::to_string(thr(c_max));
         set_condition(sensor, kResidual, true, kind, s.t, msg, out);
         raised_at_[k] = s.t;
         above_since_[k] = kNaN;
@@ -511,7 +616,9 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     if (c.kind != FaultKind::kBias && c.kind != FaultKind::kDrift && c.kind != FaultKind::kScale) {
       continue;
     }
-    const FaultKind refined = classify_shape(k);
+    // Half a classification window of the fault decides better than the raise's window (a
+    // noise increase can look offset over the raise's few samples).
+    const FaultKind refined = noise_like(k, raised_at_[k]) ? FaultKind::kNoise : classify_shape(k);
     if (refined == c.kind) continue;
     Detection d = make_detection(static_cast<Sensor>(k), true, refined, s.t);
     d.update = true;
@@ -527,13 +634,16 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     // The reconfigured observer's structured entry has about the cross residual's scale.
     const double rescale =
         k < 2 ? std::min(1.0, std::pow(st_.sigma_s(k) / st_.sigma_d(k), 2.0)) : 1.0;
-    const double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) : st_.J.maxCoeff();
-    if (hold < (k < 2 ? thr_exit_d : thr_exit)) {
+    // In units of the leave threshold: below 1 the condition may clear.
+    const double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) / thr_exit_d(k)
+                              : ratio.maxCoeff() / p_.exit_ratio;
+    const double leave = k < 2 ? thr_exit_d(k) : p_.exit_ratio * thr.maxCoeff();
+    if (hold < 1.0) {
       if (std::isnan(below_since_[k])) below_since_[k] = s.t;
       if (s.t - below_since_[k] + eps_t >= p_.leave_time &&
           s.t - raised_at_[k] + eps_t >= p_.min_active_time) {
         set_condition(static_cast<Sensor>(k), kResidual, false, cond_[k].kind, s.t,
-                      "residual back below " + std::to_string(k < 2 ? thr_exit_d : thr_exit), out);
+                      "residual back below " + std::to_string(leave), out);
         below_since_[k] = kNaN;
       }
     } else {
@@ -562,7 +672,7 @@ FaultKind Isolator::classify(int ch) const {
   // 0. Stuck: the channel repeats its value exactly (a healthy, noisy sensor never does).
   if (ch_[ch].stuck_samples >= 2) return FaultKind::kStuck;
   // 1. Spikes: the excess energy of the window sits in one or two samples.
-  const auto& w = win_sl_[ch].v;
+  const auto& w = act_.win_sl[ch].v;
   if (w.empty()) return FaultKind::kUnknown;
   std::vector<double> sq;
   sq.reserve(w.size());
@@ -617,9 +727,34 @@ FaultKind Isolator::classify_shape(int ch) const {
     for (std::size_t i = 0; i < m; ++i) z[i] = i >= k ? x[i].second : 0.0;
     best_scale = std::min(best_scale, sse2(z));
   }
-  if (best_scale < 0.6 * std::min(best_step, best_hinge)) return FaultKind::kScale;
-  if (best_hinge < 0.8 * best_step) return FaultKind::kDrift;
+  // A scale error on a signal that moves like a ramp fits a hinge as well, and a drift
+  // fits a scale: each needs to beat the other clearly, else the common offset (bias).
+  if (best_scale < 0.6 * best_step && best_scale < 0.8 * best_hinge) return FaultKind::kScale;
+  if (best_hinge < 0.8 * best_step && best_hinge < 0.8 * best_scale) return FaultKind::kDrift;
   return FaultKind::kBias;
+}
+
+bool Isolator::noise_like(int ch, double t_raise) const {
+  // The cross residual d_i (unaffected by the reconfiguration of observer i; zero-mean when
+  // healthy) since the raise, against its healthy spread (learned, or the seconds before
+  // the raise if larger): a noise increase spreads d without moving it.
+  double n0 = 0, s0 = 0, ss0 = 0, n1 = 0, s1 = 0, ss1 = 0;
+  for (const auto& [t, d] : hist_d_[ch]) {
+    if (t < t_raise - 1.0) {
+      n0 += 1;
+      s0 += d;
+      ss0 += d * d;
+    } else if (t >= t_raise - 0.5) {
+      n1 += 1;
+      s1 += d;
+      ss1 += d * d;
+    }
+  }
+  if (n0 < 10 || n1 < 10) return false;
+  const double sd = act_.sigma_d(ch);
+  const double v0 = std::max(ss0 / n0 - (s0 / n0) * (s0 / n0), sd * sd);
+  const double m1 = s1 / n1, v1 = ss1 / n1 - m1 * m1;
+  return v1 > 2.0 * v0 && m1 * m1 < 0.2 * v1;
 }
 
 }  // namespace usvfdi

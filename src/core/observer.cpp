@@ -37,6 +37,7 @@ ObserverDesign place_poles(const Mat2& A, int channel, double p1, double p2, dou
   const Vec2 w = O.partialPivLu().solve(Vec2(0.0, 1.0));
   d.k = phi * w;
   d.F = A - d.k * c;
+  d.poles = Vec2(p1, p2);
   if (!d.k.allFinite()) {
     d.reason = "pole placement produced a non-finite gain";
     return d;
@@ -71,40 +72,58 @@ bool discrete_lyapunov(const Mat2& Ad, const Vec2& g, Mat2* P) {
   return P->allFinite();
 }
 
+void foh_discretise(const Mat2& A, const Vec2& B, double h, Mat2* Phi, Vec2* Ga, Vec2* Gb) {
+  // z = [x; u; w], u' = w, w' = 0: exp(M h) gives Phi, Psi1 = int_0^h e^{A (h - s)} B ds and
+  // Psi2 = int_0^h e^{A (h - s)} B s ds; with w = (u(h) - u(0)) / h,
+  // x(h) = Phi x0 + (Psi1 - Psi2 / h) u(0) + (Psi2 / h) u(h).
+  Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+  M.topLeftCorner<2, 2>() = A * h;
+  M.block<2, 1>(0, 2) = B * h;
+  M(2, 3) = h;
+  const Eigen::Matrix4d E = M.exp();
+  *Phi = E.topLeftCorner<2, 2>();
+  const Vec2 psi1 = E.block<2, 1>(0, 2);
+  const Vec2 psi2_h = E.block<2, 1>(0, 3) / h;
+  *Ga = psi1 - psi2_h;
+  *Gb = psi2_h;
+}
+
 void DedicatedObserver::set_design(const ObserverDesign& d, const Vec2& B) {
   if (!d.ok) {
     ready_ = false;
     return;
   }
-  F_ = d.F;
   k_ = d.k;
   A_ = d.F + d.k * Eigen::RowVector2d::Unit(channel_);
+  poles_ = d.poles;
   B_ = B;
   dt_ = -1.0;  // force re-discretisation
   ready_ = true;
 }
 
 void DedicatedObserver::discretise(double dt) {
-  Eigen::Matrix<double, 2, 2> N, Nd;
-  N.col(0) = B_;
-  N.col(1) = k_;
-  zoh_discretise(F_, N, dt, &Ad_, &Nd);
-  Gd_ = Nd.col(0);
-  Gy_ = Nd.col(1);
-  N.col(1).setZero();
-  zoh_discretise(A_, N, dt, &Ad_open_, &Nd);
-  Gd_open_ = Nd.col(0);
+  foh_discretise(A_, B_, dt, &Phi_, &Ga_, &Gb_);
+  // Ackermann on (Phi, e_c^T): L = phi(Phi) O^-1 e2, phi(z) = (z - z1)(z - z2).
+  const double z1 = std::exp(poles_(0) * dt), z2 = std::exp(poles_(1) * dt);
+  Eigen::RowVector2d c = Eigen::RowVector2d::Unit(channel_);
+  Mat2 O;
+  O.row(0) = c;
+  O.row(1) = c * Phi_;
+  const Mat2 phi = Phi_ * Phi_ - (z1 + z2) * Phi_ + z1 * z2 * Mat2::Identity();
+  Gy_ = phi * O.partialPivLu().solve(Vec2(0.0, 1.0));
+  discrete_ok_ = Gy_.allFinite() && std::abs(O.determinant()) > 1e-12 * O.norm() * O.norm();
+  if (!discrete_ok_) Gy_.setZero();
+  Ad_ = Phi_ - Gy_ * c;
   dt_ = dt;
 }
 
-void DedicatedObserver::step(double dt, double delta, double y_c, bool use_measurement) {
+void DedicatedObserver::step(double dt, double delta_prev, double delta, double y_c,
+                             bool use_measurement) {
   if (!ready_ || !(dt > 0)) return;
   if (std::abs(dt - dt_) > 1e-9 * dt) discretise(dt);
-  if (use_measurement) {
-    x_ = Ad_ * x_ + Gd_ * delta + Gy_ * y_c;
-  } else {
-    x_ = Ad_open_ * x_ + Gd_open_ * delta;
-  }
+  const Vec2 open = Phi_ * x_ + Ga_ * delta_prev + Gb_ * delta;
+  // A step length at which the sampled pair is unobservable runs open loop.
+  x_ = use_measurement && discrete_ok_ ? Vec2(open + Gy_ * (y_c - x_(channel_))) : open;
 }
 
 }  // namespace usvfdi

@@ -175,6 +175,17 @@ class Loader {
              fail(n, p, "expected kreisselmeier or paper");
            }
          }},
+        {"instruments",
+         [&](const YAML::Node& n, const std::string& p) {
+           const std::string m = text(n, p);
+           if (m == "rudder") {
+             id.instruments = Instruments::kRudder;
+           } else if (m == "regressor") {
+             id.instruments = Instruments::kRegressor;
+           } else {
+             fail(n, p, "expected rudder or regressor");
+           }
+         }},
         {"eps1", num(&id.eps1)},
         {"eps2", num(&id.eps2)},
         {"gamma", num(&id.gamma)},
@@ -184,11 +195,13 @@ class Loader {
         {"warmup_time", num(&id.warmup_time)},
         {"max_gap", num(&id.max_gap)},
         {"curvature_correction", boo(&id.curvature_correction)},
+        {"cubic_correction", boo(&id.cubic_correction)},
         {"min_excitation", num(&id.min_excitation)},
         {"settle_window", num(&id.settle_window)},
         {"settle_tolerance", num(&id.settle_tolerance)},
         {"settle_windows", integ(&id.settle_windows)},
         {"settle_floor", num(&id.settle_floor)},
+        {"max_std_error", num(&id.max_std_error)},
         {"delay", num(&cfg.identification_delay)},
     };
     const std::map<std::string, Handler> isolation = {
@@ -215,6 +228,7 @@ class Loader {
         {"c_min", num(&is.c_min)},
         {"c_margin", num(&is.c_margin)},
         {"resume_time", num(&is.resume_time)},
+        {"resume_after_fault", num(&is.resume_after_fault)},
         {"stale_timeout", num(&is.stale_timeout)},
         {"stuck_time", num(&is.stuck_time)},
         {"stuck_min_samples", integ(&is.stuck_min_samples)},

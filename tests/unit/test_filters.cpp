@@ -1,9 +1,9 @@
 // Property tests of the exact sampled low-pass F(p) = eps / (p + eps) (FohLowPass).
 //
 // The reference is the closed-form response of z' = eps (u - z) to an input that is a
-// polynomial of degree <= 2 over the step, evaluated in long double by a route that is
+// polynomial of degree <= 3 over the step, evaluated in long double by a route that is
 // independent of the filter's own coefficient formulas:
-//   z(h) = e^{-x} z0 + a J0 + b J1 + c J2,   u(s) = a + b s + c s^2,   x = eps h,
+//   z(h) = e^{-x} z0 + a J0 + b J1 + c J2 + d J3,   u(s) = a + b s + c s^2 + d s^3,
 //   J_k = int_0^h eps e^{-eps (h - s)} s^k ds
 //       = h^k x sum_n (-x)^n k! / (n + k + 1)!      (series, x < 1)
 //       = h^k - (k / eps) J_{k-1},  J0 = 1 - e^{-x}  (integration by parts, x >= 1)
@@ -20,11 +20,11 @@ namespace {
 
 using ld = long double;
 
-/// J_0..J_2 of the header comment.
-void moments(ld eps, ld h, ld J[3]) {
+/// J_0..J_3 of the header comment.
+void moments(ld eps, ld h, ld J[4]) {
   const ld x = eps * h;
   if (x < 1.0L) {
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 4; ++k) {
       ld kfact = 1.0L;
       for (int i = 2; i <= k; ++i) kfact *= i;
       // term_n = (-x)^n k! / (n + k + 1)!
@@ -42,14 +42,15 @@ void moments(ld eps, ld h, ld J[3]) {
     J[0] = -std::expm1(-x);
     J[1] = h - J[0] / eps;
     J[2] = h * h - 2.0L / eps * J[1];
+    J[3] = h * h * h - 3.0L / eps * J[2];
   }
 }
 
-/// Exact response over one step to u(s) = a + b s + c s^2.
-ld exact_step(ld z0, ld a, ld b, ld c, ld eps, ld h) {
-  ld J[3];
+/// Exact response over one step to u(s) = a + b s + c s^2 + d s^3.
+ld exact_step(ld z0, ld a, ld b, ld c, ld eps, ld h, ld d = 0.0L) {
+  ld J[4];
   moments(eps, h, J);
-  return std::exp(-eps * h) * z0 + a * J[0] + b * J[1] + c * J[2];
+  return std::exp(-eps * h) * z0 + a * J[0] + b * J[1] + c * J[2] + d * J[3];
 }
 
 /// Draws eps * h log-uniformly in [1e-6, 50] and eps log-uniformly in [1e-2, 1e2].
@@ -189,7 +190,55 @@ TEST(FohLowPass, CurvedStepIsExactForQuadraticInputs) {
   }
 }
 
-TEST(FohLowPass, ErrorOrderOnASmoothInputIsTwoPlainAndThreeCurved) {
+TEST(FohLowPass, CubicStepIsExactForCubicInputs) {
+  // GIVEN u(t) = a + b t + c t^2 + d t^3 sampled at random non-uniform times, random eps*h
+  std::mt19937_64 rng(0xF0A5);
+  std::uniform_real_distribution<double> uval(-2.0, 2.0);
+  std::uniform_real_distribution<double> jitter(0.6, 1.4);
+  for (int cs = 0; cs < 300; ++cs) {
+    const StepDraw dr = draw_step(rng);
+    const double a = uval(rng), b = uval(rng) / dr.h / 50.0;
+    const double c = uval(rng) / (dr.h * dr.h) / 100.0, d = uval(rng) / std::pow(dr.h, 3) / 300.0;
+    const auto u = [&](double t) { return a + t * (b + t * (c + t * d)); };
+    FohLowPass f(dr.eps);
+    double t_ppp = 0.0, t_pp = dr.h * jitter(rng), t_p = t_pp + dr.h * jitter(rng);
+    double z = uval(rng);
+    for (int k = 0; k < 30; ++k) {
+      const double h = dr.h * jitter(rng), hp = t_p - t_pp, hpp = t_pp - t_ppp, t_n = t_p + h;
+      f.set_step(h, hp);
+      // WHEN the curvature comes from the last three samples, its change from the last four,
+      //   and the cubic step is used
+      const double udd = FohLowPass::curvature(u(t_pp), u(t_p), u(t_n), hp, h);
+      const double udd_prev = FohLowPass::curvature(u(t_ppp), u(t_pp), u(t_p), hpp, hp);
+      const double c3 = FohLowPass::third_difference(udd, udd_prev, t_n - t_ppp);
+      // THEN the third divided difference recovers d
+      const double umax =
+          std::abs(a) + std::abs(b) * t_n + std::abs(c) * t_n * t_n + std::abs(d) * t_n * t_n * t_n;
+      const double hmin = std::min({h, hp, hpp});
+      ASSERT_NEAR(c3, d, 1e-12 * umax / (hmin * hmin * hmin));
+      const double z_new = f.step_cubic(u(t_p), u(t_n), udd, c3, z);
+      // AND the step matches the analytic response to the cubic over [t_p, t_n]
+      //   (u(t_p + s) = u(t_p) + u'(t_p) s + u''(t_p)/2 s^2 + d s^3)
+      const ld ref = exact_step(z, u(t_p), b + t_p * (2.0 * c + 3.0 * d * t_p), c + 3.0 * d * t_p,
+                                dr.eps, h, d);
+      const double x = dr.eps * h;
+      const double tol = 1e-14 * (std::abs(z) + std::abs(u(t_p)) + std::abs(u(t_n))) +
+                         1e-8 * std::min(1.0, x) * (std::abs(c) + std::abs(d) * t_n) * h * h;
+      ASSERT_NEAR(z_new, static_cast<double>(ref), tol) << "x=" << x << " k=" << k;
+      // AND without the cubic term the same step is measurably off (the test can fail)
+      if (x > 1e-4 && x < 10 && std::abs(d) * h * h * h > 1e-3) {
+        const double z_quad = f.step_curved(u(t_p), u(t_n), udd, z);
+        ASSERT_GT(std::abs(z_quad - static_cast<double>(ref)), 100 * tol);
+      }
+      z = static_cast<double>(ref);
+      t_ppp = t_pp;
+      t_pp = t_p;
+      t_p = t_n;
+    }
+  }
+}
+
+TEST(FohLowPass, ErrorOrderOnASmoothInputIsTwoPlainThreeCurvedFourCubic) {
   // GIVEN u = sin(w t), eps = 1, run over 10 s with steps h and h / 2
   const double w = 1.3, eps = 1.0, T = 10.0;
   const auto exact = [&](double t) {
@@ -197,28 +246,35 @@ TEST(FohLowPass, ErrorOrderOnASmoothInputIsTwoPlainAndThreeCurved) {
     const double g = eps / (eps * eps + w * w);
     return g * (eps * std::sin(w * t) - w * std::cos(w * t) + w * std::exp(-eps * t));
   };
-  const auto run = [&](double h, bool curved) {
+  // order 1: first-order hold, 2: with curvature, 3: with the cubic term
+  const auto run = [&](double h, int order) {
     FohLowPass f(eps);
-    f.set_step(h);
+    f.set_step(h, h);
     const int n = static_cast<int>(std::lround(T / h));
+    const auto u = [&](double t) { return std::sin(w * t); };  // also before t = 0
     double z = 0.0;
     for (int k = 0; k < n; ++k) {
       const double t0 = k * h, t1 = (k + 1) * h;
-      const double udd = k == 0 ? 0.0
-                                : FohLowPass::curvature(std::sin(w * (t0 - h)), std::sin(w * t0),
-                                                        std::sin(w * t1), h, h);
-      z = curved ? f.step_curved(std::sin(w * t0), std::sin(w * t1), udd, z)
-                 : f.step(std::sin(w * t0), std::sin(w * t1), z);
+      const double udd = FohLowPass::curvature(u(t0 - h), u(t0), u(t1), h, h);
+      const double udd_prev = FohLowPass::curvature(u(t0 - 2 * h), u(t0 - h), u(t0), h, h);
+      const double c3 = FohLowPass::third_difference(udd, udd_prev, 3 * h);
+      z = order == 3   ? f.step_cubic(u(t0), u(t1), udd, c3, z)
+          : order == 2 ? f.step_curved(u(t0), u(t1), udd, z)
+                       : f.step(u(t0), u(t1), z);
     }
     return std::abs(z - exact(n * h));
   };
   // WHEN the step is halved
-  // THEN the plain first-order-hold error falls ~4x (O(h^2)) and the curved one ~8x (O(h^3))
-  const double e1 = run(0.02, false), e2 = run(0.01, false);
-  const double c1 = run(0.02, true), c2 = run(0.01, true);
+  // THEN the plain first-order-hold error falls ~4x (O(h^2)), the curved one ~8x (O(h^3))
+  //   and the cubic one ~16x (O(h^4))
+  const double e1 = run(0.02, 1), e2 = run(0.01, 1);
+  const double c1 = run(0.02, 2), c2 = run(0.01, 2);
+  const double k1 = run(0.02, 3), k2 = run(0.01, 3);
   EXPECT_NEAR(e1 / e2, 4.0, 0.4);
   EXPECT_NEAR(c1 / c2, 8.0, 1.2);
+  EXPECT_NEAR(k1 / k2, 16.0, 2.4);
   EXPECT_LT(c1, 0.1 * e1);
+  EXPECT_LT(k1, 0.1 * c1);
 }
 
 }  // namespace

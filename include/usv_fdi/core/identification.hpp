@@ -5,14 +5,50 @@
 //   q = F1[y],  m = p F1[y] - B F1[delta] = eps1 (y - q) - B F1[delta]   =>  m = A q
 //   paper:        R = [[q1 q2], [qb1 qb2]] (second filter eps2), G1 = [m1 mb1]^T, G2 = [m2 mb2]^T,
 //                 psi = det R, [h1 h2]^T = adj(R) G1, [h3 h4]^T = adj(R) G2  =>  h_n = psi a_n
-//   kreisselmeier: Phi' = -lambda Phi + q q^T, Y' = -lambda Y + q m^T  =>  Y = Phi A^T,
-//                 psi = det Phi, adj(Phi) Y = psi A^T
-//   scalar laws:  a_n' = gamma psi (h_n - psi a_n)                 (paper)
-//                 a_n' = gamma psi (h_n - psi a_n) / (mu + psi^2)   (normalised)
+//   kreisselmeier: Phi' = -lambda Phi + z q^T, Y' = -lambda Y + z m^T  =>  Y = Phi A^T,
+//                 psi = det Phi, adj(Phi) Y = psi A^T, for ANY instrument z:
+//                 z = q (least squares, "regressor") or z = F1[x_aux] ("rudder",
+//                 instrumental variables from an auxiliary model driven by the rudder)
+//   scalar laws:  a_n' = gamma psi (h_n - psi a_n)                       (paper)
+//                 a_n' = gamma psi (h_n - psi a_n) / (mu S^2 + psi^2)     (normalised)
+//                 S = the regressor's scale (Phi00 Phi11, or the column-norm product of the
+//                 paper's R), so psi / S is the excitation in [0, 1] and mu is dimensionless:
+//                 the law does not slow down on a vessel whose signals are merely small.
 // Each scalar law is advanced by its exact solution over one step, which is stable for any
-// gain and step: a <- h/psi + (a - h/psi) exp(-gamma psi^2 dt / (mu + psi^2)).
+// gain and step: a <- h/psi + (a - h/psi) exp(-gamma psi^2 dt / (mu S^2 + psi^2)).
+//
+// Why instruments. The regressor q = F1[y] is built from the MEASURED y = x + n, so it
+// carries the sensor noise low-pass filtered, n_q = F1[n], of covariance N ~ D eps1 dt / 2
+// (D = diag(sigma_v^2, sigma_r^2)) for white noise sampled every dt: the sampled noise has
+// the spectral density D dt, so its filtered part grows with the sample interval. With
+// z = q the memories are Phi = Phi_x + int N, and the estimate is A Phi_x (Phi_x + N)^-1:
+// every entry is shrunk towards zero (errors in variables, attenuation), amplified by
+// 1/excitation when v and r move together (a turning vessel: excitation ~0.04 on the
+// Otter). With the Otter's INS noise that is 4-6 % at 10 Hz and ~1 % at 50 Hz. The current
+// sample's noise also enters both q (weight 5/12 eps1 dt with the curvature term) and m
+// (weight eps1): a cross term E[n_q n_m^T] = -D eps1^2 dt / 12 in Y, eps1/6 of N and of the
+// opposite sign (O(dt^2) without the curvature term). It is not the main mechanism: most
+// of N comes from the earlier samples in F1's memory, so no discretisation of q removes it.
+//
+// Instruments uncorrelated with the INS noise remove both terms at any rate and noise
+// level: E[z n_q^T] = E[z n_m^T] = 0, so Y = Phi A^T holds in expectation, and exactly on
+// noise-free data. The instruments are those of the refined instrumental-variable method
+// for continuous-time models (Young; Garnier): the state of an auxiliary model driven by
+// the rudder alone, x_aux' = A_aux x_aux + B delta, filtered like the regressor, z =
+// F1[x_aux]. With A_aux close to A, z resembles the noise-free q, so the extended regressor
+// is as well conditioned as the least-squares one. A_aux is the least-squares estimate of
+// the same memory (biased by a few % at 10 Hz, which costs the instruments nothing),
+// refreshed once per settle_window, shifted left if needed so that its slowest pole is no
+// slower than -lambda (a course-unstable estimate would make x_aux diverge); before any
+// estimate exists it is -eps1 [[1, -1], [1, 1]] (poles -eps1 +- i eps1, excited by any
+// B != 0). The rows of z are rescaled to the RMS of q's components (any invertible row
+// scaling leaves adj(Phi) Y / det Phi unchanged), so psi and the excitation keep their
+// least-squares meaning. The rudder must not be driven by the INS noise: an autopilot that
+// steers on the measured yaw rate feeds a filtered trace of the gyro noise back into
+// delta, and with it a (much smaller, second-order) correlation into the instruments.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "usv_fdi/core/filters.hpp"
@@ -25,17 +61,25 @@ enum class IdentMethod : std::uint8_t {
   kKreisselmeier,  ///< one filter eps1 + Kreisselmeier extension (default, best on benchmark)
 };
 
+/// Instruments of the Kreisselmeier extension (Phi' = -lambda Phi + z q^T).
+enum class Instruments : std::uint8_t {
+  kRegressor = 0,  ///< z = q: least squares (biased by sensor noise, see header comment)
+  kRudder,         ///< z = F1[x_aux], auxiliary model driven by the rudder (default)
+};
+
 struct IdentificationParams {
   IdentMethod method = IdentMethod::kKreisselmeier;
-  double eps1 = 1.0;        ///< filter F1 bandwidth [1/s]
+  Instruments instruments = Instruments::kRudder;  ///< kreisselmeier method only
+  double eps1 = 1.0;                               ///< filter F1 bandwidth [1/s]
   double eps2 = 2.0;        ///< filter F2 bandwidth [1/s] (paper method only)
-  double gamma = 1.0;       ///< adaptation gain (units depend on mu; see header comment)
+  double gamma = 1.0;       ///< adaptation gain: [1/s] normalised, [1/(psi^2 s)] paper law
   bool normalised = true;   ///< false: the paper's law a' = gamma psi (h - psi a)
-  double mu = 1e-14;        ///< normaliser of the normalised law (> 0)
-  double lambda = 0.01;     ///< Kreisselmeier forgetting rate [1/s] (100 s memory)
+  double mu = 1e-8;         ///< normaliser of the normalised law, in excitation^2 (> 0)
+  double lambda = 0.005;    ///< Kreisselmeier forgetting rate [1/s] (200 s memory)
   double warmup_time = -1;  ///< filter warm-up before regressions are used [s]; <0: 10/min(eps)
   double max_gap = 1.0;     ///< a time gap longer than this restarts the filters [s]
   bool curvature_correction = true;  ///< filter the inputs' curvature too (O(h^3) error)
+  bool cubic_correction = true;      ///< and their cubic term (O(h^4); needs the curvature)
   Vec4 a0 = Vec4::Zero();            ///< initial estimate [a1 a2 a3 a4]
   // Convergence criterion (reported, and what arms the isolation thread).
   double min_excitation = 0.01;    ///< normalised excitation in [0,1] needed to converge
@@ -43,6 +87,11 @@ struct IdentificationParams {
   double settle_tolerance = 0.01;  ///< max relative change of every a_n over one window
   int settle_windows = 3;          ///< consecutive settled windows needed
   double settle_floor = 1e-4;      ///< absolute floor of the relative change's denominator
+  /// Kreisselmeier only: every a_n's standard error (its upper 90 % confidence bound, as it
+  /// is estimated from few batches at first), relative to max(|a_n|, settle_floor), must be
+  /// below this too (a growing memory moves slowly, so settling alone can pass on an
+  /// estimate that is still several % off).
+  double max_std_error = 0.05;
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
@@ -50,13 +99,27 @@ struct IdentificationParams {
 
 /// One snapshot of the identification state (published by the identification thread).
 struct Estimate {
-  double t = kNaN;            ///< time of the last sample used [s]
-  Mat2 A = Mat2::Zero();      ///< current estimate of A
-  bool converged = false;     ///< sticky once the criterion held
-  double excitation = 0.0;    ///< normalised excitation of the extended regressor, [0,1]
-  double psi = 0.0;           ///< mixed regressor psi
-  double time_constant = 0;   ///< current time constant of the scalar laws [s] (inf: none)
-  double settling = 1.0;      ///< max relative change of a_n over the last window
+  double t = kNaN;           ///< time of the last sample used [s]
+  Mat2 A = Mat2::Zero();     ///< current estimate of A
+  bool converged = false;    ///< sticky once the criterion held
+  double excitation = 0.0;   ///< normalised excitation of the extended regressor, [0,1]
+  double psi = 0.0;          ///< mixed regressor psi
+  double time_constant = 0;  ///< current time constant of the scalar laws [s] (inf: none)
+  double settling = 1.0;     ///< max relative change of a_n over the last window
+  /// Standard error of each a_n [a_n's unit] (Kreisselmeier; NaN for the paper's method,
+  /// and until three batches are in): row i of A^ is off by Phi^-1 sum w z e_i, e = m - A^ q
+  /// the equation error, so Cov = Phi^-1 V_i Phi^-T with V_i = Var(sum w z e_i) estimated
+  /// by tapered batch means: sums b_j of h^2 z e_i over batches of 5 / eps1 s (longer than
+  /// e's correlation time), h a Hann window, two batches overlapping by half, recomputed
+  /// with the current estimate from the batches' own sums (b_j = Y_j - Phi_j A^T), give the
+  /// rate at which the variance grows (sum b_j b_j^T / sum int h^4 dt over the last 20
+  /// batches, times n / (n - 2): A^ was fitted to them), times the memory's sum of squared
+  /// weights. The taper matters: e's largest part, eps1 (n - F1[n]) in m = q' - B F1[delta],
+  /// is the derivative of F1's noise; it averages out against the slow instruments, but a
+  /// hard-edged batch sum of it is an end-point difference that would swamp a small error
+  /// (the Mariner's yaw row). No assumption on the noise's spectrum is needed. Updated once
+  /// per batch.
+  Vec4 std_error = Vec4::Constant(kNaN);
   bool frozen = false;        ///< last sample was not used because of a freeze request
   bool warming_up = true;     ///< filters are settling; regressions not used yet
   std::uint64_t updates = 0;  ///< samples that updated the estimate
@@ -82,9 +145,15 @@ class Identifier {
   /// Latest regression pair (m = A q holds for noise-free data).
   const Vec2& q() const { return q_; }
   const Vec2& m() const { return m_; }
+  /// Latest instrument vector (z = q for the regressor instruments).
+  const Vec2& z() const { return z_; }
+  /// The auxiliary model's matrix A_aux that generates the rudder instruments.
+  const Mat2& aux_model() const { return A_aux_; }
 
  private:
   void restart_filters(const Sample& s);
+  void step_instruments(double dt, double delta_prev);
+  void refresh_aux_model(double t);
   void advance_scalar_laws(double dt);
   void update_convergence(double t);
 
@@ -94,18 +163,50 @@ class Identifier {
   FohLowPass f1_, f2_;
   bool have_prev_ = false;
   bool restart_pending_ = true;
+  double t_last_ = kNaN;  ///< time of the last accepted sample (frozen or not)
   Sample prev_{};
   Sample prev2_{};  ///< the sample before prev_ (for the curvature)
   bool have_prev2_ = false;
+  using Vec3 = Eigen::Matrix<double, 3, 1>;
+  Vec3 dd_prev_ = Vec3::Zero();  ///< curvatures of v, r, delta over the previous stencil
+  double t_dd_prev_ = kNaN;      ///< first node of that stencil
+  bool have_dd_prev_ = false;
   double t_start_ = kNaN;  ///< time the filters (re)started
   // filter states: F1[y], F1[delta], F2[y], F2[delta]
   Vec2 q_ = Vec2::Zero(), m_ = Vec2::Zero();
   Vec2 qb_ = Vec2::Zero(), mb_ = Vec2::Zero();
   double fd1_ = 0.0, fd2_ = 0.0;
-  // Kreisselmeier memory
-  Mat2 Phi_ = Mat2::Zero(), Y_ = Mat2::Zero();
+  // Rudder instruments: auxiliary model x_aux' = A_aux x_aux + B delta, z = F1[x_aux].
+  Mat2 A_aux_;
+  Mat2 Ad_aux_ = Mat2::Identity();
+  Vec2 Bd_aux_ = Vec2::Zero();
+  double h_aux_ = -1.0;        ///< step Ad_aux_, Bd_aux_ were computed for (<0: stale)
+  double t_aux_ = kNaN;        ///< time A_aux_ was last refreshed
+  Vec2 x_aux_ = Vec2::Zero();  ///< kept across filter restarts (it depends on delta only)
+  Vec2 z_ = Vec2::Zero();
+  // Kreisselmeier memories: least squares (int q q^T, int q m^T), which also gives A_aux and
+  // the scale of q, and with rudder instruments int z q^T, int z m^T and diag int z z^T.
+  Mat2 Pqq_ = Mat2::Zero(), Yqm_ = Mat2::Zero();
+  Mat2 Pzq_ = Mat2::Zero(), Yzm_ = Mat2::Zero();
+  Vec2 Szz_ = Vec2::Zero();
+  // For the standard errors: the last batches' sums int z q^T, int z m^T.
+  struct Batch {
+    Mat2 P = Mat2::Zero();  ///< int h^2 z q^T
+    Mat2 G = Mat2::Zero();  ///< int h^2 z m^T
+    double H2 = 0.0;        ///< int h^4 dt
+    double T = 0.0;         ///< time since the window began [s] (< 0: not begun)
+  };
+  static constexpr int kBatches = 20;
+  static constexpr int kMinBatches = 3;        ///< no standard error from fewer batches
+  static constexpr double kBatchLength = 5.0;  ///< batch length x eps1 [-]
+  std::array<Batch, 2> open_;                  ///< the two windows being summed
+  std::array<Batch, kBatches> batches_;        ///< ring of completed batches
+  int n_batches_ = 0, head_ = 0;
+  double W2_ = 0.0;  ///< the memory's sum of squared weights, per batch [s]
+  void update_std_error();
   bool ext_started_ = false;
   double psi_ = 0.0;
+  double scale_ = 0.0;  ///< S: psi / S is the excitation
   Vec4 h_ = Vec4::Zero();
   Vec4 a_;
   // convergence bookkeeping

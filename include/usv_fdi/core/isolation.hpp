@@ -50,6 +50,10 @@ struct IsolationParams {
   double c_min = 0.8;             ///< isolation needs C_i >= c_min ...
   double c_margin = 0.3;          ///< ... and C_i - C_other >= c_margin; else sensor unknown
   double resume_time = 2.0;       ///< quiet time before identification resumes [s]
+  /// ... and after a fault condition cleared: a fault that comes and goes with the signal
+  /// (a scale error is invisible while the vessel holds its course) must not reach the
+  /// estimate of A in its quiet spells [s].
+  double resume_after_fault = 10.0;
   // Sensor-level checks.
   double stale_timeout = 0.5;    ///< no valid value for this long: stale [s]
   double stuck_time = 0.5;       ///< value unchanged for this long: stuck [s]
@@ -92,15 +96,21 @@ struct IsolatorStatus {
   bool armed = false;
   bool learning = false;
   bool settling = false;
+  bool relearning = false;    ///< a redesign is learning its statistics beside the design in force
+  std::uint64_t designs = 0;  ///< observer designs put in force (the first at arming)
   std::string observer_problem;  ///< why an observer design was refused (empty when fine)
   Mat2 A_design = Mat2::Zero();
   Vec2 k_v = Vec2::Zero(), k_g = Vec2::Zero();
   Vec2 sigma_s = Vec2::Zero();  ///< scales of the structured residual [m/s, rad/s]
   Vec2 sigma_d = Vec2::Zero();  ///< scales of the cross residual
-  double threshold = 0.0;       ///< enter threshold on J_N in force
-  double threshold_d = 0.0;     ///< threshold on the cross statistic D_N (hold: exit_ratio x)
-  Vec2 J = Vec2::Zero();        ///< windowed statistic per channel (structured)
-  Vec2 D = Vec2::Zero();        ///< windowed statistic per channel (cross)
+  double threshold = 0.0;       ///< largest enter threshold on J_N in force (of thresholds)
+  double threshold_d = 0.0;     ///< largest threshold on the cross statistic D_N
+  /// Per channel [accelerometer, gyro]: each residual channel's healthy statistics differ
+  /// (the gyro's carries most of the model mismatch), so each has its own thresholds.
+  Vec2 thresholds = Vec2::Zero();    ///< enter thresholds on J_N
+  Vec2 thresholds_d = Vec2::Zero();  ///< thresholds on D_N (hold: exit_ratio x)
+  Vec2 J = Vec2::Zero();             ///< windowed statistic per channel (structured)
+  Vec2 D = Vec2::Zero();             ///< windowed statistic per channel (cross)
   double c_a = 0.0, c_g = 0.0;
   InputHealth input;
   std::uint64_t samples = 0;
@@ -112,7 +122,9 @@ class Isolator {
   Isolator(const IsolationParams& params, const Vec2& B);
 
   /// Installs the latest identification snapshot. Arms (designs the observers) the first
-  /// time the estimate has converged; afterwards redesigns when A moved enough.
+  /// time the estimate has converged; afterwards, when A moved by more than
+  /// redesign_tolerance, designs new observers that settle and learn their scales and
+  /// thresholds on healthy data beside the ones in force, and replace them once learned.
   void set_estimate(const Estimate& est);
 
   /// Processes one sample; appends every change of a sensor's fault condition to out.
@@ -151,7 +163,41 @@ class Isolator {
     double outlier_start = kNaN;
   };
 
-  bool design(const Mat2& A);
+  /// One pair of dedicated observers on one design of A, with the residual statistics
+  /// learned for that design. The healthy residual of a design carries the model mismatch
+  /// of the estimate it was made from, so its scales and thresholds hold for it alone: a
+  /// redesign builds a new bank that settles and learns on healthy data beside the one in
+  /// force (which keeps detecting), and replaces it once it has learned.
+  struct Bank {
+    DedicatedObserver v, g;
+    Mat2 A = Mat2::Zero();
+    Vec2 k_v = Vec2::Zero(), k_g = Vec2::Zero();
+    bool theory_scales_pending = false;
+    Vec2 floor_s = Vec2::Zero(), floor_d = Vec2::Zero();  ///< floors of the learned scales
+    Vec2 sigma_s = Vec2::Zero(), sigma_d = Vec2::Zero();
+    Vec2 threshold = Vec2::Zero(), threshold_d = Vec2::Zero();  ///< per channel
+    double settle_until = kNaN;
+    double learned_time = 0.0;  ///< healthy data used by the current learning phase [s]
+    bool scales_learned = false;
+    bool learned = false;
+    // Learning samples (robust statistics: a fault during learning cannot inflate the
+    // scales unless it covers half of the learning time).
+    std::array<std::vector<double>, 4> learn_raw;         ///< s_a, s_g, d_a, d_g raw residuals
+    std::array<std::vector<double>, 2> learn_J, learn_D;  ///< per channel
+    std::array<Window, 2> win_s;                          ///< clipped squared structured residuals
+    std::array<Window, 2> win_sl;  ///< signed structured residuals (classification)
+    std::array<Window, 2> win_d;   ///< clipped squared cross residuals
+    Vec2 J = Vec2::Zero(), D = Vec2::Zero();
+  };
+
+  bool design(const Mat2& A, Bank* b);
+  void propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok);
+  /// Learning and evaluation windows of one bank for one sample. Fills raw (structured and
+  /// cross residuals) and sw (whitened structured, NaN where unusable). Returns false while
+  /// the bank settles (nothing evaluated).
+  bool evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
+                double raw[4], Vec2* sw);
+  void publish_bank();
   void set_condition(Sensor sensor, Source src, bool on, FaultKind kind, double t,
                      const std::string& message, std::vector<Detection>* out);
   Detection make_detection(Sensor sensor, bool active, FaultKind kind, double t) const;
@@ -159,6 +205,7 @@ class Isolator {
   void residual_checks(const Sample& s, double dt, std::vector<Detection>* out);
   FaultKind classify(int ch) const;
   FaultKind classify_shape(int ch) const;
+  bool noise_like(int ch, double t_raise) const;
   double onset_estimate(int ch, double t) const;
   std::size_t window_samples(double dt) const;
   double learned_threshold(std::vector<double>* healthy) const;
@@ -166,25 +213,19 @@ class Isolator {
   IsolationParams p_;
   Vec2 B_;
   IsolatorStatus st_;
-  DedicatedObserver obs_v_, obs_g_;
+  Bank act_;     ///< the bank in force
+  Bank shadow_;  ///< a redesign learning beside it
+  bool has_shadow_ = false;
+  std::array<bool, 2> resync_{false, false};  ///< restart a channel's own observer (cleared)
+  std::array<double, 2> resettle_until_{kNaN, kNaN};  ///< the restarted observer settles
   bool have_prev_ = false;
   Sample prev_{};
   double t_armed_ = kNaN;
-  double settle_until_ = kNaN;
-  bool theory_scales_pending_ = false;
   double settle_time_ = 0.0;
   double t_last_suspect_ = -1e300;
+  double t_last_fault_ = -1e300;
   bool freeze_ = false;
   bool scales_configured_ = false;
-  bool scales_learned_ = false;
-  Vec2 floor_s_ = Vec2::Zero(), floor_d_ = Vec2::Zero();  ///< floors of the learned scales
-  // Learning samples (robust statistics: a fault during learning cannot inflate the scales
-  // unless it covers half of the learning time).
-  std::array<std::vector<double>, 4> learn_raw_;  ///< s_a, s_g, d_a, d_g raw residuals
-  std::vector<double> learn_J_, learn_D_;
-  std::array<Window, 2> win_s_;   ///< clipped squared structured residuals
-  std::array<Window, 2> win_sl_;  ///< signed structured residuals (classification)
-  std::array<Window, 2> win_d_;   ///< clipped squared cross residuals
   std::array<std::deque<std::pair<double, double>>, 2> hist_s_;  ///< (t, whitened structured)
   std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
   std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
