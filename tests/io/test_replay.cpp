@@ -2,8 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <memory>
 #include <set>
@@ -97,12 +95,16 @@ TEST(Replay, CsvReplayGivesTheEventsOfTheInMemoryRun) {
 }
 
 TEST(Replay, SummaryCountsRaisesNotRefinements) {
-  // GIVEN the golden paper scenario, where a raised fault's kind is refined later (the
-  // refinement is published again with state "raised")
-  std::ifstream in(kSource + "/tests/golden/paper.csv");
-  ASSERT_TRUE(in.good());
-  const std::string csv((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const EngineConfig cfg = load_engine_config(kSource + "/config/scenarios/paper.yaml");
+  // GIVEN a gyro scale fault that is raised as a bias and refined to scale a few seconds
+  // later (the refinement is published again with state "raised")
+  SimConfig sim;
+  sim.vessel = otter();
+  sim.rate_hz = 10.0;
+  sim.duration = 200.0;
+  sim.seed = 2;
+  sim.faults = {{Sensor::kGyro, FaultKind::kScale, 150.0, 170.0, 0.5, 2.0}};
+  const std::string csv = sim_csv(sim);
+  const EngineConfig cfg = load_engine_config(kSource + "/tests/golden/faults_otter.yaml");
   // WHEN it is replayed
   RunSummary sum;
   const auto recs = parse_lines(replay_text(cfg, csv, &sum));
