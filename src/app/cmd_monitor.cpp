@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -55,8 +56,9 @@ double wall_now() {
 struct Row {
   std::uint32_t mmsi = 0;
   FaultEvent ev;
-  double written = 0.0;  ///< the sidecar's write time (source timestamp) [s since epoch]
-  bool alive = true;     ///< false: the sidecar that published it is gone
+  double written = 0.0;           ///< the sidecar's write time (source timestamp) [s since epoch]
+  bool alive = true;              ///< false: the sidecar that published it is gone
+  fdds::InstanceHandle_t writer;  ///< the sidecar's FaultEvent writer
 };
 using RowKey = std::pair<std::uint32_t, int>;
 
@@ -64,6 +66,7 @@ struct VesselStatus {
   fdi::FdiStatus st;
   double written = 0.0;
   bool alive = true;
+  fdds::InstanceHandle_t writer;
 };
 
 std::string json_row(const Row& r) {
@@ -165,26 +168,67 @@ bool parse_ack(const std::string& spec, fdi::FaultAck* out, std::string* why) {
   return true;
 }
 
+/// Records the writers (sidecars) that went away: Fast DDS 2.9 neither delivers an
+/// instance-state sample when a writer disappears nor implements get_matched_publications(),
+/// so the monitor learns it from on_subscription_matched. Only copies a handle under a lock.
+class GoneWriters : public fdds::DataReaderListener {
+ public:
+  void on_subscription_matched(fdds::DataReader*,
+                               const fdds::SubscriptionMatchedStatus& info) override {
+    std::lock_guard<std::mutex> lock(m_);
+    if (info.current_count_change < 0) {
+      gone_.push_back(info.last_publication_handle);
+    } else if (info.current_count_change > 0) {
+      back_.push_back(info.last_publication_handle);
+    }
+  }
+  /// Moves the handles of writers gone (and come back) since the last call into the outputs.
+  void take(std::vector<fdds::InstanceHandle_t>* gone, std::vector<fdds::InstanceHandle_t>* back) {
+    std::lock_guard<std::mutex> lock(m_);
+    gone->swap(gone_);
+    back->swap(back_);
+    gone_.clear();
+    back_.clear();
+  }
+
+ private:
+  std::mutex m_;
+  std::vector<fdds::InstanceHandle_t> gone_, back_;
+};
+
 /// The FaultEvent (and optionally FdiStatus) side of the monitor.
 class FleetView {
  public:
   FleetView(dds::DdsContext& ctx, const MonitorArgs& a)
-      : a_(a), filter_(a.mmsi.begin(), a.mmsi.end()) {
-    events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
+      : ctx_(ctx), a_(a), filter_(a.mmsi.begin(), a.mmsi.end()) {
+    events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader,
+                                 &events_gone_, fdds::StatusMask::subscription_matched());
     events_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
     ws_.attach_condition(events_->get_statuscondition());
     if (a.status) {
-      status_ = &ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader);
+      status_ = &ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader,
+                                   &status_gone_, fdds::StatusMask::subscription_matched());
       status_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
       ws_.attach_condition(status_->get_statuscondition());
     }
   }
+  ~FleetView() {
+    // The readers go before their listeners (a failure is logged by Fast DDS).
+    try {
+      if (status_ != nullptr) ctx_.delete_reader(*status_);
+      ctx_.delete_reader(*events_);
+    } catch (const std::exception& e) {
+      spdlog::warn("{}", e.what());
+    }
+  }
+  FleetView(const FleetView&) = delete;
+  FleetView& operator=(const FleetView&) = delete;
 
   /// Waits up to `timeout` for data; applies what arrived. Returns true if a row changed.
   bool poll(double timeout) {
     fdds::ConditionSeq active;
     ws_.wait(active, eprosima::fastrtps::Duration_t(timeout));
-    bool changed = false;
+    bool changed = mark_gone_writers();
     fdi::FaultEvent d;
     fdds::SampleInfo info;
     while (events_->take_next_sample(&d, &info) == ReturnCode_t::RETCODE_OK) {
@@ -210,6 +254,7 @@ class FleetView {
         continue;
       }
       r.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
+      r.writer = info.publication_handle;
       const RowKey key{r.mmsi, static_cast<int>(r.ev.sensor)};
       handles_[info.instance_handle] = key;
       rows_[key] = r;
@@ -231,6 +276,7 @@ class FleetView {
         VesselStatus& v = vessels_[s.mmsi()];
         v.st = s;
         v.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
+        v.writer = info.publication_handle;
         v.alive = true;
         status_handles_[info.instance_handle] = s.mmsi();
         if (a_.json) {
@@ -253,14 +299,44 @@ class FleetView {
   }
 
  private:
+  /// Flags the rows (and vessel statuses) whose writer is gone. Returns true if one changed.
+  bool mark_gone_writers() {
+    bool changed = false;
+    std::vector<fdds::InstanceHandle_t> gone, back;
+    events_gone_.take(&gone, &back);
+    for (const auto& h : gone) {
+      for (auto& [key, r] : rows_) {
+        if (r.writer == h && r.alive) {
+          r.alive = false;
+          changed = true;
+          if (a_.json) emit_json(r);
+        }
+      }
+    }
+    if (status_ != nullptr) {
+      status_gone_.take(&gone, &back);
+      for (const auto& h : gone) {
+        for (auto& [m, v] : vessels_) {
+          if (v.writer == h && v.alive) {
+            v.alive = false;
+            changed = true;
+          }
+        }
+      }
+    }
+    return changed;
+  }
+
   void emit_json(const Row& r) const {
     if (a_.once) return;  // --once prints the final state only
     std::printf("%s\n", json_row(r).c_str());
     std::fflush(stdout);
   }
 
+  dds::DdsContext& ctx_;
   const MonitorArgs& a_;
   std::set<std::uint32_t> filter_;
+  GoneWriters events_gone_, status_gone_;
   fdds::DataReader* events_ = nullptr;
   fdds::DataReader* status_ = nullptr;
   fdds::WaitSet ws_;
@@ -283,19 +359,8 @@ std::string refusal_reason(const fdi::FaultAck& ack, const Row* row) {
   return "no confirmation from the sidecar" + state;
 }
 
-int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a) {
-  std::vector<fdi::FaultAck> acks;
-  for (const std::string& spec : a.acks) {
-    fdi::FaultAck ack;
-    std::string why;
-    if (!parse_ack(spec, &ack, &why)) {
-      spdlog::error("{}", why);
-      return kExitUsage;
-    }
-    ack.operator_id(a.operator_id.substr(0, 63).c_str());
-    ack.stamp(wall_now());
-    acks.push_back(ack);
-  }
+int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
+              std::vector<fdi::FaultAck> acks) {
   fdds::DataWriter& w = ctx.create_writer(dds::TopicId::kFaultAck, dds::profiles::kFaultAckWriter);
   // Bounded wait until a sidecar's ack reader is matched (so the ack is not lost) and the
   // latched state has arrived (so that the confirmation can be recognised).
@@ -321,13 +386,14 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a) {
   const auto settle = Clock::now() + std::chrono::milliseconds(300);
   while (Clock::now() < settle) view.poll(0.05);
   int rc = kExitOk;
-  for (const fdi::FaultAck& ack : acks) {
+  for (fdi::FaultAck& ack : acks) {
     const RowKey key{ack.mmsi(), ack.sensor()};
     const auto it = view.rows().find(key);
     const Row* row = it == view.rows().end() ? nullptr : &it->second;
     const std::string who = "MMSI " + std::to_string(ack.mmsi()) + " " +
                             to_string(static_cast<Sensor>(ack.sensor())) + " #" +
                             std::to_string(ack.sequence());
+    ack.stamp(wall_now());
     dds::write(w, ack);
     spdlog::info("ack sent: {} by {}", who, a.operator_id);
     // Confirmed when the instance moves past the acknowledged sequence to an acknowledged state.
@@ -357,6 +423,17 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a) {
 
 int run_monitor(const MonitorArgs& a) {
   block_stop_signals();  // before Fast DDS starts its threads
+  std::vector<fdi::FaultAck> acks;
+  for (const std::string& spec : a.acks) {
+    fdi::FaultAck ack;
+    std::string why;
+    if (!parse_ack(spec, &ack, &why)) {
+      spdlog::error("{}", why);
+      return kExitUsage;
+    }
+    ack.operator_id(a.operator_id.substr(0, 63).c_str());
+    acks.push_back(ack);
+  }
   dds::DdsConfig cfg;
   try {
     cfg = make_dds_config(a.dds);
@@ -375,7 +452,7 @@ int run_monitor(const MonitorArgs& a) {
   }
   const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
   if (!a.acks.empty()) {
-    const int rc = send_acks(*ctx, *view, a);
+    const int rc = send_acks(*ctx, *view, a, acks);
     if (rc != kExitOk || !keep_watching) return rc;
   }
   const double duration = a.once && a.duration == 0.0 ? 3.0 : a.duration;

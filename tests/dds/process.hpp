@@ -13,8 +13,11 @@ namespace usv_fdi::dds::test {
 
 class ChildProcess {
  public:
-  /// Spawns argv[0] with the given arguments; stdout is captured, stderr is inherited.
-  explicit ChildProcess(const std::vector<std::string>& argv);
+  /// Spawns argv[0] with the given arguments; stdout is captured. stderr goes to
+  /// `stderr_path` (created/truncated) if given, else it is inherited. `extra_env` entries
+  /// ("NAME=value") are added to (or override) this process's environment.
+  explicit ChildProcess(const std::vector<std::string>& argv, const std::string& stderr_path = "",
+                        const std::vector<std::string>& extra_env = {});
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
