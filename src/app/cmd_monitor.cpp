@@ -396,9 +396,13 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
     ack.stamp(wall_now());
     dds::write(w, ack);
     spdlog::info("ack sent: {} by {}", who, a.operator_id);
-    // Confirmed when the instance moves past the acknowledged sequence to an acknowledged state.
-    const auto confirm_by = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                               std::chrono::duration<double>(a.ack_timeout));
+    // Confirmed when the instance moves from the acknowledged sequence past it, to an
+    // acknowledged state. If the latched state is already past it, the ack is stale: the
+    // sidecar refuses it, no need to wait.
+    const bool already_past = row != nullptr && row->ev.sequence > ack.sequence();
+    const auto confirm_by =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(already_past ? 0.0 : a.ack_timeout));
     bool confirmed = false;
     while (!confirmed && Clock::now() < confirm_by) {
       view.poll(0.05);
@@ -410,8 +414,13 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
     }
     if (!confirmed) {
       const auto r = view.rows().find(key);
-      spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
-                    a.ack_timeout, refusal_reason(ack, r == view.rows().end() ? row : &r->second));
+      const std::string reason = refusal_reason(ack, r == view.rows().end() ? row : &r->second);
+      if (already_past) {
+        spdlog::error("ack {} not accepted: {} (the sidecar logs its refusal)", who, reason);
+      } else {
+        spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
+                      a.ack_timeout, reason);
+      }
       rc = kExitFailure;
       continue;
     }
@@ -423,6 +432,7 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
 
 int run_monitor(const MonitorArgs& a) {
   block_stop_signals();  // before Fast DDS starts its threads
+  route_fastdds_log_to_spdlog();
   std::vector<fdi::FaultAck> acks;
   for (const std::string& spec : a.acks) {
     fdi::FaultAck ack;

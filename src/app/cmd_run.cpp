@@ -41,6 +41,7 @@ int run_service(const RunArgs& a) {
   // SIGINT/SIGTERM are blocked before any DDS or pipeline thread exists and received with
   // sigtimedwait below: no signal handler, so nothing runs in signal context.
   block_stop_signals();
+  route_fastdds_log_to_spdlog();
   service::ServiceConfig cfg;
   try {
     cfg = service::load_service_config(a.dds.config);

@@ -20,6 +20,7 @@ using Clock = std::chrono::steady_clock;
 int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,
                        const dds::DdsConfig& cfg, const PublishOptions& opt) {
   block_stop_signals();  // before Fast DDS starts its threads
+  route_fastdds_log_to_spdlog();
   if (vessels.empty()) return kExitUsage;
   std::vector<std::unique_ptr<Simulator>> sims;
   try {
