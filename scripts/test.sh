@@ -11,7 +11,9 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 "$root/scripts/build.sh" -DUSV_FDI_BUILD_TESTS=ON -DUSV_FDI_BUILD_BENCH=ON
-ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j 2 --timeout 1500
+failed=()  # test runs that failed: every run goes ahead, the script fails at the end
+ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j 2 --timeout 1500 ||
+  failed+=("${BUILD_DIR:-build}")
 
 # Only what the service's tests need is built with a sanitizer (Fast DDS itself is not
 # instrumented; see tests/sanitizers/ for the runtime options and suppressions).
@@ -26,5 +28,11 @@ for san in ${USV_FDI_SANITIZERS-thread address}; do
   cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUSV_FDI_SANITIZER="$san" \
     -DUSV_FDI_BUILD_TESTS=ON -DUSV_FDI_BUILD_BENCH=OFF
   cmake --build "$dir" -j "$(nproc)" --target "${san_targets[@]}"
-  ctest --test-dir "$dir" -L 'service|dds_e2e' --output-on-failure -j 2 --timeout 600
+  ctest --test-dir "$dir" -L 'service|dds_e2e' --output-on-failure -j 2 --timeout 600 ||
+    failed+=("$dir")
 done
+if ((${#failed[@]} > 0)); then
+  echo "test.sh: tests failed in: ${failed[*]}" >&2
+  exit 1
+fi
+echo "test.sh: all tests passed"

@@ -277,6 +277,10 @@ void register_sim_command(CommandRegistry& registry) {
                   "--publish: wait up to this long for a sidecar's readers before starting [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  sub->add_option("--min-readers", args->pub.min_readers,
+                  "--publish: start once this many INS and rudder readers (sidecars) are matched")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
   sub->add_option("--linger", args->pub.linger,
                   "--publish: keep the writers this long after the last sample [s]")
       ->check(CLI::NonNegativeNumber)

