@@ -1,5 +1,6 @@
-// Minimal child-process helper for the DDS tests: posix_spawn with stdout on a pipe, bounded
-// waits everywhere, SIGKILL + reap on destruction so a failing test never leaves a process behind.
+// Minimal child-process helper for the DDS tests: fork/exec with stdout on a pipe, bounded
+// waits everywhere, SIGKILL + reap on destruction, and PR_SET_PDEATHSIG so that a child dies
+// with the test even when the test process itself is killed: no test leaves a process behind.
 #pragma once
 
 #include <sys/types.h>
