@@ -1,14 +1,18 @@
-// usv-fdi monitor: the shore-side subscriber. Late-join aware (RELIABLE + TRANSIENT_LOCAL
-// reader sized for a fleet): on start it receives the latched state of every fault instance.
+// usv-fdi monitor: the shore-side subscriber. Late-join aware: its FaultEvent reader is
+// RELIABLE + TRANSIENT_LOCAL, KEEP_LAST 1 per instance, sized for a fleet (4096 instances),
+// so on start it receives the latched state of every fault instance of every vessel.
+// With --ack it acknowledges an event and waits for the sidecar's confirmation.
 #include <spdlog/spdlog.h>
 
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -26,28 +30,43 @@ namespace usvfdi::app {
 namespace {
 
 namespace dds = usv_fdi::dds;
-using eprosima::fastdds::dds::ConditionSeq;
-using eprosima::fastdds::dds::DataReader;
-using eprosima::fastdds::dds::DataWriter;
-using eprosima::fastdds::dds::StatusMask;
-using eprosima::fastdds::dds::WaitSet;
+namespace fdds = eprosima::fastdds::dds;
+using eprosima::fastrtps::types::ReturnCode_t;
 using Clock = std::chrono::steady_clock;
 
 struct MonitorArgs {
   DdsCli dds;
   std::vector<std::uint32_t> mmsi;  ///< filter (empty: every vessel)
   bool json = false;
+  bool status = false;            ///< also show each vessel's FdiStatus
   std::vector<std::string> acks;  ///< MMSI:SENSOR:SEQUENCE
   std::string operator_id = "operator";
-  double duration = 0.0;  ///< stop after this long (0: until a signal)
-  bool once = false;      ///< print the latched state after --duration (default 3 s) and exit
-  int expect = 0;         ///< stop once this many instances are known
+  double ack_timeout = 5.0;         ///< wait for the sidecar's confirmation of an ack [s]
+  double discovery_timeout = 10.0;  ///< wait for a sidecar's ack reader [s]
+  double duration = 0.0;            ///< stop after this long (0: until a signal)
+  bool once = false;  ///< print the latched state after --duration (default 3 s) and exit
+  int expect = 0;     ///< stop once this many instances are known
 };
+
+/// Wall-clock seconds since the epoch (the writer's source timestamps are on this clock).
+double wall_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
 
 struct Row {
   std::uint32_t mmsi = 0;
   FaultEvent ev;
-  Clock::time_point received;
+  double written = 0.0;           ///< the sidecar's write time (source timestamp) [s since epoch]
+  bool alive = true;              ///< false: the sidecar that published it is gone
+  fdds::InstanceHandle_t writer;  ///< the sidecar's FaultEvent writer
+};
+using RowKey = std::pair<std::uint32_t, int>;
+
+struct VesselStatus {
+  fdi::FdiStatus st;
+  double written = 0.0;
+  bool alive = true;
+  fdds::InstanceHandle_t writer;
 };
 
 std::string json_row(const Row& r) {
@@ -60,24 +79,62 @@ std::string json_row(const Row& r) {
      << ",\"threshold\":" << io::json_number(e.threshold)
      << ",\"onset_time\":" << io::json_number(e.onset_time)
      << ",\"detection_time\":" << io::json_number(e.detection_time)
-     << ",\"sequence\":" << e.sequence << ",\"a\":[" << io::json_number(e.A(0, 0)) << ","
-     << io::json_number(e.A(0, 1)) << "," << io::json_number(e.A(1, 0)) << ","
-     << io::json_number(e.A(1, 1)) << "],\"message\":" << io::json_string(e.message) << "}";
+     << ",\"stamp\":" << io::json_number(e.t) << ",\"sequence\":" << e.sequence << ",\"a\":["
+     << io::json_number(e.A(0, 0)) << "," << io::json_number(e.A(0, 1)) << ","
+     << io::json_number(e.A(1, 0)) << "," << io::json_number(e.A(1, 1))
+     << "],\"age_s\":" << io::json_number(wall_now() - r.written)
+     << ",\"alive\":" << (r.alive ? "true" : "false")
+     << ",\"message\":" << io::json_string(e.message) << "}";
   return os.str();
 }
 
-void print_table(const std::map<std::pair<std::uint32_t, int>, Row>& rows) {
-  const auto now = Clock::now();
-  std::printf("%-10s %-13s %-20s %-8s %5s %5s %5s %7s  %s\n", "MMSI", "SENSOR", "STATE", "KIND",
-              "C_A", "C_G", "SEQ", "AGE[s]", "MESSAGE");
+std::string json_status(const VesselStatus& v) {
+  const fdi::FdiStatus& s = v.st;
+  std::ostringstream os;
+  os << "{\"type\":\"status\",\"mmsi\":" << s.mmsi() << ",\"stamp\":" << io::json_number(s.stamp())
+     << ",\"a\":[" << io::json_number(s.a()[0]) << "," << io::json_number(s.a()[1]) << ","
+     << io::json_number(s.a()[2]) << "," << io::json_number(s.a()[3])
+     << "],\"converged\":" << (s.converged() ? "true" : "false")
+     << ",\"armed\":" << (s.armed() ? "true" : "false")
+     << ",\"excitation\":" << io::json_number(s.excitation())
+     << ",\"ins_healthy\":" << (s.ins_healthy() ? "true" : "false")
+     << ",\"rudder_healthy\":" << (s.rudder_healthy() ? "true" : "false")
+     << ",\"samples\":" << s.samples() << ",\"dropped\":" << s.dropped()
+     << ",\"age_s\":" << io::json_number(wall_now() - v.written)
+     << ",\"alive\":" << (v.alive ? "true" : "false")
+     << ",\"message\":" << io::json_string(s.message().to_string()) << "}";
+  return os.str();
+}
+
+void print_table(const std::map<RowKey, Row>& rows,
+                 const std::map<std::uint32_t, VesselStatus>* vessels) {
+  const double now = wall_now();
+  std::printf("%-10s %-13s %-21s %-8s %5s %5s %4s %8s %8s %7s  %s\n", "VESSEL", "SENSOR", "STATE",
+              "KIND", "C_A", "C_G", "SEQ", "ONSET[s]", "T[s]", "AGE[s]", "MESSAGE");
   for (const auto& [key, r] : rows) {
-    const double age = std::chrono::duration<double>(now - r.received).count();
-    std::printf("%-10u %-13s %-20s %-8s %5.2f %5.2f %5llu %7.1f  %s\n", r.mmsi,
-                to_string(r.ev.sensor), to_string(r.ev.state), to_string(r.ev.kind), r.ev.c_a,
-                r.ev.c_g, static_cast<unsigned long long>(r.ev.sequence), age,
-                r.ev.message.c_str());
+    std::string state = to_string(r.ev.state);
+    if (!r.alive) state += "?";  // the sidecar is gone: last known state
+    std::printf("%-10u %-13s %-21s %-8s %5.2f %5.2f %4llu %8.2f %8.2f %7.1f  %s\n", r.mmsi,
+                to_string(r.ev.sensor), state.c_str(), to_string(r.ev.kind), r.ev.c_a, r.ev.c_g,
+                static_cast<unsigned long long>(r.ev.sequence), r.ev.onset_time, r.ev.t,
+                now - r.written, r.ev.message.c_str());
   }
-  std::printf("(%zu fault instances)\n", rows.size());
+  std::printf("(%zu fault instances%s)\n", rows.size(),
+              std::any_of(rows.begin(), rows.end(), [](const auto& kv) { return !kv.second.alive; })
+                  ? "; '?': sidecar gone, last known state"
+                  : "");
+  if (vessels != nullptr) {
+    for (const auto& [mmsi, v] : *vessels) {
+      const fdi::FdiStatus& s = v.st;
+      std::printf(
+          "vessel %u%s: t=%.1f s, %s%s, A=[%.4g %.4g; %.4g %.4g], %llu samples, %llu "
+          "dropped: %s\n",
+          mmsi, v.alive ? "" : " (sidecar gone)", s.stamp(),
+          s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0],
+          s.a()[1], s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
+          static_cast<unsigned long long>(s.dropped()), s.message().c_str());
+    }
+  }
   std::fflush(stdout);
 }
 
@@ -86,30 +143,296 @@ bool parse_ack(const std::string& spec, fdi::FaultAck* out, std::string* why) {
   std::string m, s, q;
   if (!std::getline(ss, m, ':') || !std::getline(ss, s, ':') || !std::getline(ss, q) || m.empty() ||
       q.empty()) {
-    *why = "--ack " + spec + ": expected MMSI:SENSOR:SEQUENCE";
+    *why = "--ack " + spec + ": expected MMSI:SENSOR:SEQUENCE (e.g. 257000001:gyro:3)";
     return false;
   }
   Sensor sensor;
   if (!parse_sensor(s, &sensor)) {
-    *why = "--ack " + spec + ": sensor must be accelerometer, gyro or unknown";
+    *why = "--ack " + spec + ": sensor '" + s + "' is not accelerometer, gyro or unknown";
     return false;
   }
   try {
     std::size_t pm = 0, pq = 0;
     const unsigned long mmsi = std::stoul(m, &pm);
     const unsigned long long seq = std::stoull(q, &pq);
-    if (pm != m.size() || pq != q.size() || mmsi == 0 || mmsi > 999999999ul) throw 1;
+    if (pm != m.size() || pq != q.size() || mmsi == 0 || mmsi > 999999999ul || seq == 0) {
+      throw std::invalid_argument(spec);
+    }
     out->mmsi(static_cast<std::uint32_t>(mmsi));
     out->sensor(static_cast<std::uint8_t>(sensor));
     out->sequence(seq);
-  } catch (...) {
-    *why = "--ack " + spec + ": MMSI and SEQUENCE must be positive integers";
+  } catch (const std::exception&) {
+    *why = "--ack " + spec + ": MMSI (1..999999999) and SEQUENCE (>= 1) must be integers";
     return false;
   }
   return true;
 }
 
-int send_acks(dds::DdsContext& ctx, const MonitorArgs& a) {
+/// Records the writers (sidecars) that went away: Fast DDS 2.9 neither delivers an
+/// instance-state sample when a writer disappears nor implements get_matched_publications(),
+/// so the monitor learns it from on_subscription_matched. Only copies a handle under a lock.
+class GoneWriters : public fdds::DataReaderListener {
+ public:
+  void on_subscription_matched(fdds::DataReader*,
+                               const fdds::SubscriptionMatchedStatus& info) override {
+    std::lock_guard<std::mutex> lock(m_);
+    if (info.current_count_change < 0) {
+      gone_.push_back(info.last_publication_handle);
+    } else if (info.current_count_change > 0) {
+      back_.push_back(info.last_publication_handle);
+    }
+  }
+  /// Moves the handles of writers gone (and come back) since the last call into the outputs.
+  void take(std::vector<fdds::InstanceHandle_t>* gone, std::vector<fdds::InstanceHandle_t>* back) {
+    std::lock_guard<std::mutex> lock(m_);
+    gone->swap(gone_);
+    back->swap(back_);
+    gone_.clear();
+    back_.clear();
+  }
+
+ private:
+  std::mutex m_;
+  std::vector<fdds::InstanceHandle_t> gone_, back_;
+};
+
+/// The FaultEvent (and optionally FdiStatus) side of the monitor.
+class FleetView {
+ public:
+  FleetView(dds::DdsContext& ctx, const MonitorArgs& a)
+      : ctx_(ctx), a_(a), filter_(a.mmsi.begin(), a.mmsi.end()) {
+    events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader,
+                                 &events_gone_, fdds::StatusMask::subscription_matched());
+    events_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+    ws_.attach_condition(events_->get_statuscondition());
+    if (a.status) {
+      status_ = &ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader,
+                                   &status_gone_, fdds::StatusMask::subscription_matched());
+      status_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+      ws_.attach_condition(status_->get_statuscondition());
+    }
+  }
+  ~FleetView() {
+    // The readers go before their listeners (a failure is logged by Fast DDS).
+    try {
+      if (status_ != nullptr) ctx_.delete_reader(*status_);
+      ctx_.delete_reader(*events_);
+    } catch (const std::exception& e) {
+      spdlog::warn("{}", e.what());
+    }
+  }
+  FleetView(const FleetView&) = delete;
+  FleetView& operator=(const FleetView&) = delete;
+
+  /// Waits up to `timeout` for data; applies what arrived. Returns true if a row changed.
+  bool poll(double timeout) {
+    fdds::ConditionSeq active;
+    ws_.wait(active, eprosima::fastrtps::Duration_t(timeout));
+    bool changed = mark_gone_writers();
+    fdi::FaultEvent d;
+    fdds::SampleInfo info;
+    while (events_->take_next_sample(&d, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) {
+        // Disposed / no writers: keep the last known state, flagged.
+        const auto it = handles_.find(info.instance_handle);
+        if (it != handles_.end() && rows_.count(it->second)) {
+          Row& r = rows_[it->second];
+          if (r.alive) {
+            r.alive = false;
+            changed = true;
+            if (a_.json) emit_json(r);
+          }
+        }
+        continue;
+      }
+      if (!filter_.empty() && !filter_.count(d.mmsi())) continue;
+      Row r;
+      r.mmsi = d.mmsi();
+      if (!service::from_dds(d, &r.ev)) {
+        spdlog::warn("ignored a FaultEvent from MMSI {} with unknown sensor/state/kind octets",
+                     d.mmsi());
+        continue;
+      }
+      r.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
+      r.writer = info.publication_handle;
+      const RowKey key{r.mmsi, static_cast<int>(r.ev.sensor)};
+      handles_[info.instance_handle] = key;
+      rows_[key] = r;
+      changed = true;
+      if (a_.json) emit_json(r);
+    }
+    if (status_ != nullptr) {
+      fdi::FdiStatus s;
+      while (status_->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data) {
+          const auto it = status_handles_.find(info.instance_handle);
+          if (it != status_handles_.end() && vessels_.count(it->second)) {
+            vessels_[it->second].alive = false;
+            changed = true;
+          }
+          continue;
+        }
+        if (!filter_.empty() && !filter_.count(s.mmsi())) continue;
+        VesselStatus& v = vessels_[s.mmsi()];
+        v.st = s;
+        v.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
+        v.writer = info.publication_handle;
+        v.alive = true;
+        status_handles_[info.instance_handle] = s.mmsi();
+        if (a_.json) {
+          std::printf("%s\n", json_status(v).c_str());
+          std::fflush(stdout);
+        }
+      }
+    }
+    return changed;
+  }
+
+  int matched_writers() const {
+    fdds::SubscriptionMatchedStatus st;
+    events_->get_subscription_matched_status(st);
+    return st.current_count;
+  }
+  const std::map<RowKey, Row>& rows() const { return rows_; }
+  const std::map<std::uint32_t, VesselStatus>* vessels() const {
+    return status_ != nullptr ? &vessels_ : nullptr;
+  }
+
+ private:
+  /// Flags the rows (and vessel statuses) whose writer is gone. Returns true if one changed.
+  bool mark_gone_writers() {
+    bool changed = false;
+    std::vector<fdds::InstanceHandle_t> gone, back;
+    events_gone_.take(&gone, &back);
+    for (const auto& h : gone) {
+      for (auto& [key, r] : rows_) {
+        if (r.writer == h && r.alive) {
+          r.alive = false;
+          changed = true;
+          if (a_.json) emit_json(r);
+        }
+      }
+    }
+    if (status_ != nullptr) {
+      status_gone_.take(&gone, &back);
+      for (const auto& h : gone) {
+        for (auto& [m, v] : vessels_) {
+          if (v.writer == h && v.alive) {
+            v.alive = false;
+            changed = true;
+          }
+        }
+      }
+    }
+    return changed;
+  }
+
+  void emit_json(const Row& r) const {
+    if (a_.once) return;  // --once prints the final state only
+    std::printf("%s\n", json_row(r).c_str());
+    std::fflush(stdout);
+  }
+
+  dds::DdsContext& ctx_;
+  const MonitorArgs& a_;
+  std::set<std::uint32_t> filter_;
+  GoneWriters events_gone_, status_gone_;
+  fdds::DataReader* events_ = nullptr;
+  fdds::DataReader* status_ = nullptr;
+  fdds::WaitSet ws_;
+  std::map<RowKey, Row> rows_;
+  std::map<fdds::InstanceHandle_t, RowKey> handles_;
+  std::map<std::uint32_t, VesselStatus> vessels_;
+  std::map<fdds::InstanceHandle_t, std::uint32_t> status_handles_;
+};
+
+/// Why the sidecar will refuse an ack, judged from the latched state the monitor sees.
+std::string refusal_reason(const fdi::FaultAck& ack, const Row* row) {
+  if (row == nullptr) return "no such fault instance is latched on this domain/partition";
+  const std::uint64_t cur = row->ev.sequence;
+  std::string state = " (current #" + std::to_string(cur) + ", " + to_string(row->ev.state) + ")";
+  if (ack.sequence() < cur) return "stale sequence" + state;
+  if (ack.sequence() > cur) return "unknown sequence" + state;
+  if (row->ev.state != FaultState::kRaised && row->ev.state != FaultState::kClearedUnacknowledged) {
+    return "nothing to acknowledge" + state;
+  }
+  return "no confirmation from the sidecar" + state;
+}
+
+int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
+              std::vector<fdi::FaultAck> acks) {
+  fdds::DataWriter& w = ctx.create_writer(dds::TopicId::kFaultAck, dds::profiles::kFaultAckWriter);
+  // Bounded wait until a sidecar's ack reader is matched (so the ack is not lost) and the
+  // latched state has arrived (so that the confirmation can be recognised).
+  const auto t_start = Clock::now();
+  const auto deadline = t_start + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(a.discovery_timeout));
+  fdds::PublicationMatchedStatus st;
+  for (;;) {
+    w.get_publication_matched_status(st);
+    if (st.current_count > 0 || Clock::now() >= deadline) break;
+    view.poll(0.05);
+    if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
+  }
+  if (st.current_count == 0) {
+    spdlog::error("no sidecar subscribes to acknowledgements on domain {} (waited {:g} s)",
+                  ctx.config().domain_id, a.discovery_timeout);
+    return kExitFailure;
+  }
+  spdlog::debug("{} sidecar(s) matched after {:.3f} s", st.current_count,
+                std::chrono::duration<double>(Clock::now() - t_start).count());
+  // The reader side of the match completes asynchronously; give it, and the historical
+  // FaultEvents, a moment (bounded).
+  const auto settle = Clock::now() + std::chrono::milliseconds(300);
+  while (Clock::now() < settle) view.poll(0.05);
+  int rc = kExitOk;
+  for (fdi::FaultAck& ack : acks) {
+    const RowKey key{ack.mmsi(), ack.sensor()};
+    const auto it = view.rows().find(key);
+    const Row* row = it == view.rows().end() ? nullptr : &it->second;
+    const std::string who = "MMSI " + std::to_string(ack.mmsi()) + " " +
+                            to_string(static_cast<Sensor>(ack.sensor())) + " #" +
+                            std::to_string(ack.sequence());
+    ack.stamp(wall_now());
+    dds::write(w, ack);
+    spdlog::info("ack sent: {} by {}", who, a.operator_id);
+    // Confirmed when the instance moves from the acknowledged sequence past it, to an
+    // acknowledged state. If the latched state is already past it, the ack is stale: the
+    // sidecar refuses it, no need to wait.
+    const bool already_past = row != nullptr && row->ev.sequence > ack.sequence();
+    const auto confirm_by =
+        Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(already_past ? 0.0 : a.ack_timeout));
+    bool confirmed = false;
+    while (!confirmed && Clock::now() < confirm_by) {
+      view.poll(0.05);
+      const auto r = view.rows().find(key);
+      confirmed = r != view.rows().end() && r->second.ev.sequence > ack.sequence() &&
+                  (r->second.ev.state == FaultState::kActiveAcknowledged ||
+                   r->second.ev.state == FaultState::kAcknowledged);
+      if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
+    }
+    if (!confirmed) {
+      const auto r = view.rows().find(key);
+      const std::string reason = refusal_reason(ack, r == view.rows().end() ? row : &r->second);
+      if (already_past) {
+        spdlog::error("ack {} not accepted: {} (the sidecar logs its refusal)", who, reason);
+      } else {
+        spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
+                      a.ack_timeout, reason);
+      }
+      rc = kExitFailure;
+      continue;
+    }
+    const Row& now = view.rows().at(key);
+    spdlog::info("ack {} accepted: now #{} {}", who, now.ev.sequence, to_string(now.ev.state));
+  }
+  return rc;
+}
+
+int run_monitor(const MonitorArgs& a) {
+  block_stop_signals();  // before Fast DDS starts its threads
+  route_fastdds_log_to_spdlog();
   std::vector<fdi::FaultAck> acks;
   for (const std::string& spec : a.acks) {
     fdi::FaultAck ack;
@@ -119,34 +442,8 @@ int send_acks(dds::DdsContext& ctx, const MonitorArgs& a) {
       return kExitUsage;
     }
     ack.operator_id(a.operator_id.substr(0, 63).c_str());
-    ack.stamp(
-        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
     acks.push_back(ack);
   }
-  DataWriter& w = ctx.create_writer(dds::TopicId::kFaultAck, dds::profiles::kFaultAckWriter);
-  // Wait (bounded) until a sidecar's ack reader is matched, so the ack is not lost.
-  eprosima::fastdds::dds::PublicationMatchedStatus st;
-  const auto deadline = Clock::now() + std::chrono::seconds(5);
-  while (Clock::now() < deadline) {
-    w.get_publication_matched_status(st);
-    if (st.current_count > 0) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (st.current_count == 0) {
-    spdlog::error("no sidecar subscribes to acknowledgements on this domain/partition (5 s)");
-    return kExitFailure;
-  }
-  for (const fdi::FaultAck& ack : acks) {
-    dds::write(w, ack);
-    spdlog::info("ack sent: MMSI {} {} #{} by {}", ack.mmsi(),
-                 to_string(static_cast<Sensor>(ack.sensor())), ack.sequence(), a.operator_id);
-  }
-  w.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(3, 0));
-  return kExitOk;
-}
-
-int run_monitor(const MonitorArgs& a) {
-  block_stop_signals();
   dds::DdsConfig cfg;
   try {
     cfg = make_dds_config(a.dds);
@@ -155,63 +452,47 @@ int run_monitor(const MonitorArgs& a) {
     return kExitConfig;
   }
   std::unique_ptr<dds::DdsContext> ctx;
+  std::unique_ptr<FleetView> view;
   try {
     ctx = std::make_unique<dds::DdsContext>(cfg);
+    view = std::make_unique<FleetView>(*ctx, a);
   } catch (const std::exception& e) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
+  const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
   if (!a.acks.empty()) {
-    const int rc = send_acks(*ctx, a);
-    if (rc != kExitOk || (!a.once && a.duration == 0.0 && a.expect == 0)) return rc;
+    const int rc = send_acks(*ctx, *view, a, acks);
+    if (rc != kExitOk || !keep_watching) return rc;
   }
-  DataReader& reader =
-      ctx->create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
-  reader.get_statuscondition().set_enabled_statuses(StatusMask::data_available());
-  WaitSet ws;
-  ws.attach_condition(reader.get_statuscondition());
-
-  const std::set<std::uint32_t> filter(a.mmsi.begin(), a.mmsi.end());
-  std::map<std::pair<std::uint32_t, int>, Row> rows;
   const double duration = a.once && a.duration == 0.0 ? 3.0 : a.duration;
   const auto start = Clock::now();
-  std::vector<fdi::FaultEvent> buf;
+  bool printed = false;
   for (;;) {
-    ConditionSeq active;
-    ws.wait(active, eprosima::fastrtps::Duration_t(0, 200000000));
-    buf.clear();
-    dds::take_all(reader, buf);
-    bool changed = false;
-    for (const fdi::FaultEvent& d : buf) {
-      if (!filter.empty() && !filter.count(d.mmsi())) continue;
-      Row r;
-      r.mmsi = d.mmsi();
-      if (!service::from_dds(d, &r.ev)) {
-        spdlog::warn("ignored a FaultEvent from MMSI {} with unknown sensor/state/kind", d.mmsi());
-        continue;
-      }
-      r.received = Clock::now();
-      rows[{r.mmsi, static_cast<int>(r.ev.sensor)}] = r;
-      changed = true;
-      if (a.json && !a.once) {
-        std::printf("%s\n", json_row(r).c_str());
-        std::fflush(stdout);
-      }
+    const bool changed = view->poll(0.2);
+    if (changed && !a.json && !a.once) {
+      print_table(view->rows(), view->vessels());
+      printed = true;
     }
-    if (changed && !a.json && !a.once) print_table(rows);
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const bool enough = a.expect > 0 && static_cast<int>(rows.size()) >= a.expect;
+    const bool enough = a.expect > 0 && static_cast<int>(view->rows().size()) >= a.expect;
     if (enough || (duration > 0 && elapsed >= duration) || wait_for_stop_signal(0.0) != 0) break;
   }
   if (a.once) {
     if (a.json) {
-      for (const auto& [key, r] : rows) std::printf("%s\n", json_row(r).c_str());
+      for (const auto& [key, r] : view->rows()) std::printf("%s\n", json_row(r).c_str());
+      if (view->vessels() != nullptr) {
+        for (const auto& [m, v] : *view->vessels()) std::printf("%s\n", json_status(v).c_str());
+      }
+      std::fflush(stdout);
     } else {
-      print_table(rows);
+      print_table(view->rows(), view->vessels());
     }
+  } else if (!a.json && !printed) {
+    print_table(view->rows(), view->vessels());
   }
-  if (a.expect > 0 && static_cast<int>(rows.size()) < a.expect) {
-    spdlog::error("saw {} fault instances, expected {}", rows.size(), a.expect);
+  if (a.expect > 0 && static_cast<int>(view->rows().size()) < a.expect) {
+    spdlog::error("saw {} fault instances, expected {}", view->rows().size(), a.expect);
     return kExitFailure;
   }
   return kExitOk;
@@ -221,16 +502,28 @@ int run_monitor(const MonitorArgs& a) {
 
 void register_monitor_command(CommandRegistry& registry) {
   static MonitorArgs args;
-  CLI::App* sub =
-      registry.add("monitor",
-                   "shore-side view of every vessel's latched faults (late-join aware); --ack to "
-                   "acknowledge",
-                   [] { return run_monitor(args); });
+  CLI::App* sub = registry.add(
+      "monitor",
+      "shore-side table of every vessel's latched fault instances (late-join aware); --ack to "
+      "acknowledge one",
+      [] { return run_monitor(args); });
   add_dds_options(sub, &args.dds);
-  sub->add_option("--mmsi", args.mmsi, "only these vessels (repeatable)");
-  sub->add_flag("--json", args.json, "JSON Lines instead of a table");
-  sub->add_option("--ack", args.acks, "acknowledge MMSI:SENSOR:SEQUENCE (repeatable)");
+  sub->add_option("--mmsi", args.mmsi, "only these vessels (repeatable)")
+      ->check(CLI::Range(1u, 999999999u));
+  sub->add_flag("--json", args.json, "JSON Lines instead of a table: one line per received update");
+  sub->add_flag("--status", args.status, "also show each vessel's detector status (FdiStatus)");
+  sub->add_option("--ack", args.acks,
+                  "acknowledge MMSI:SENSOR:SEQUENCE and wait for the sidecar's confirmation "
+                  "(repeatable; exit 1 if one is not accepted)");
   sub->add_option("--operator", args.operator_id, "operator id sent with --ack")
+      ->capture_default_str();
+  sub->add_option("--ack-timeout", args.ack_timeout,
+                  "wait this long for the sidecar's confirmation of each ack [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--discovery-timeout", args.discovery_timeout,
+                  "--ack: wait this long for a sidecar's acknowledgement reader [s]")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   sub->add_option("--duration", args.duration, "stop after this many seconds (0: on a signal)")
       ->check(CLI::NonNegativeNumber);

@@ -1,5 +1,11 @@
-// usv-fdi sim: simulate a voyage (optionally with INS faults) into a CSV for replay.
+// usv-fdi sim: simulate a voyage (optionally with INS faults) into a CSV for replay, or, with
+// --publish, as INS and rudder samples on DDS for one or many vessels (sim_publish.cpp).
 #include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <set>
 
 #include <fstream>
 #include <iostream>
@@ -14,6 +20,12 @@
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/io/scenarios.hpp"
+#ifdef USV_FDI_APP_WITH_DDS
+#include "dds_options.hpp"
+#include "sim_publish.hpp"
+#include "usv_fdi/dds_service/service.hpp"
+#include "usv_fdi/io/config.hpp"
+#endif
 
 namespace usvfdi::app {
 namespace {
@@ -28,7 +40,35 @@ struct SimArgs {
   std::string steering;  ///< empty: the scenario's
   double noise_scale = 1.0;
   std::string output;
+#ifdef USV_FDI_APP_WITH_DDS
+  bool publish = false;
+  std::vector<std::uint32_t> mmsi;
+  std::vector<std::uint32_t> healthy;  ///< vessels without the scenario's / shared faults
+  PublishOptions pub;
+  DdsCli dds;
+#endif
 };
+
+/// Splits an optional "MMSI@" prefix off a --fault spec (0: every vessel).
+bool split_fault_target(const std::string& spec, std::uint32_t* mmsi, std::string* rest,
+                        std::string* why) {
+  const auto at = spec.find('@');
+  *mmsi = 0;
+  *rest = spec;
+  if (at == std::string::npos) return true;
+  const std::string m = spec.substr(0, at);
+  try {
+    std::size_t used = 0;
+    const unsigned long long v = std::stoull(m, &used);
+    if (used != m.size() || v == 0 || v > 999999999ull) throw std::invalid_argument(m);
+    *mmsi = static_cast<std::uint32_t>(v);
+  } catch (const std::exception&) {
+    *why = "fault '" + spec + "': '" + m + "' before '@' is not an MMSI (1..999999999)";
+    return false;
+  }
+  *rest = spec.substr(at + 1);
+  return true;
+}
 
 int run_sim(const SimArgs& a) {
   VesselModel vessel;
@@ -44,20 +84,99 @@ int run_sim(const SimArgs& a) {
   } else {
     c = io::faults_scenario(vessel, a.rate_hz, a.seed);
   }
-  for (const std::string& spec : a.faults) {
+  std::map<std::uint32_t, std::vector<FaultInjection>> targeted;  ///< MMSI@ faults
+  for (const std::string& text : a.faults) {
     FaultInjection f;
-    std::string why;
-    if (!io::parse_fault_spec(spec, &f, &why)) {
+    std::string why, spec;
+    std::uint32_t target = 0;
+    if (!split_fault_target(text, &target, &spec, &why) || !io::parse_fault_spec(spec, &f, &why)) {
       spdlog::error("--fault: {}", why);
       return kExitUsage;
     }
-    c.faults.push_back(f);
+    if (target == 0) {
+      c.faults.push_back(f);
+    } else {
+      targeted[target].push_back(f);
+    }
   }
   if (a.duration) c.duration = *a.duration;
   if (a.steering == "autopilot") c.steering = Steering::kAutopilot;
   if (a.steering == "sine") c.steering = Steering::kSine;
   c.sigma_v = a.noise_scale * vessel.sigma_v;
   c.sigma_r = a.noise_scale * vessel.sigma_r;
+
+#ifdef USV_FDI_APP_WITH_DDS
+  if (a.publish) {
+    std::vector<std::uint32_t> mmsis = a.mmsi;
+    if (mmsis.empty() && !a.dds.config.empty()) {
+      try {
+        const std::uint32_t m = service::load_service_config(a.dds.config).mmsi;
+        if (m != 0) mmsis.push_back(m);
+      } catch (const io::ConfigError& e) {
+        spdlog::error("{}", e.what());
+        return kExitConfig;
+      }
+    }
+    if (mmsis.empty()) {
+      spdlog::error(
+          "--publish needs the vessels' MMSIs: --mmsi (repeatable) or service.mmsi in --config");
+      return kExitUsage;
+    }
+    const std::set<std::uint32_t> unique(mmsis.begin(), mmsis.end());
+    if (unique.size() != mmsis.size()) {
+      spdlog::error("--mmsi: every vessel needs its own MMSI (a value is repeated)");
+      return kExitUsage;
+    }
+    for (const auto& kv : targeted) {
+      if (!unique.count(kv.first)) {
+        spdlog::error("--fault {}@...: {} is not one of the published vessels (--mmsi)", kv.first,
+                      kv.first);
+        return kExitUsage;
+      }
+    }
+    for (const std::uint32_t h : a.healthy) {
+      if (!unique.count(h)) {
+        spdlog::error("--healthy {}: not one of the published vessels (--mmsi)", h);
+        return kExitUsage;
+      }
+    }
+    std::vector<std::pair<std::uint32_t, SimConfig>> vessels;
+    for (std::size_t i = 0; i < mmsis.size(); ++i) {
+      SimConfig vc = c;
+      vc.seed = c.seed + i;  // independent noise per vessel
+      if (std::find(a.healthy.begin(), a.healthy.end(), mmsis[i]) != a.healthy.end()) {
+        vc.faults.clear();
+      }
+      const auto it = targeted.find(mmsis[i]);
+      if (it != targeted.end())
+        vc.faults.insert(vc.faults.end(), it->second.begin(), it->second.end());
+      spdlog::info("vessel MMSI {}: {} {} Hz {} s seed {}", mmsis[i], vessel.name, vc.rate_hz,
+                   vc.duration, vc.seed);
+      for (const FaultInjection& f : vc.faults)
+        spdlog::info("  fault {}", io::format_fault_spec(f));
+      vessels.emplace_back(mmsis[i], vc);
+    }
+    usv_fdi::dds::DdsConfig dds;
+    bool config_reliable = false;  // service.reliable_inputs of --config
+    try {
+      dds = make_dds_config(a.dds, &config_reliable);
+    } catch (const io::ConfigError& e) {
+      spdlog::error("{}", e.what());
+      return kExitConfig;
+    }
+    PublishOptions opt = a.pub;
+    opt.reliable = a.pub.reliable || config_reliable;
+    return publish_simulation(vessels, dds, opt);
+  }
+#endif
+  if (a.output.empty()) {
+    spdlog::error("sim: give --output FILE (or --publish)");
+    return kExitUsage;
+  }
+  if (!targeted.empty() || !a.healthy.empty()) {
+    spdlog::error("sim: MMSI@ faults and --healthy only apply with --publish");
+    return kExitUsage;
+  }
 
   std::unique_ptr<Simulator> sim;
   try {
@@ -127,15 +246,49 @@ void register_sim_command(CommandRegistry& registry) {
       ->check(CLI::PositiveNumber);
   sub->add_option("--seed", args->seed, "noise seed")->capture_default_str();
   sub->add_option("--fault", args->faults,
-                  "extra fault sensor:kind:start:end[:magnitude[:spike_rate]] "
-                  "(e.g. gyro:bias:20:40:0.005); repeatable");
+                  "extra fault [MMSI@]sensor:kind:start:end[:magnitude[:spike_rate]] "
+                  "(e.g. gyro:bias:20:40:0.005; MMSI@ limits it to one vessel with --publish); "
+                  "repeatable");
   sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
       ->check(CLI::IsMember({"autopilot", "sine"}));
   sub->add_option("--noise-scale", args->noise_scale,
                   "factor on the vessel's realistic sensor noise (0: noise-free)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+#ifdef USV_FDI_APP_WITH_DDS
+  sub->add_option("--output", args->output, "output CSV ('-': stdout); or --publish");
+  sub->add_flag("--publish", args->publish,
+                "publish INS and rudder samples on DDS instead of writing a CSV");
+  sub->add_option("--mmsi", args->mmsi,
+                  "--publish: a vessel's MMSI (repeatable: one simulation per vessel, seed+i)")
+      ->check(CLI::Range(1u, 999999999u));
+  sub->add_option("--healthy", args->healthy,
+                  "--publish: this vessel gets neither the scenario's faults nor the --fault "
+                  "specs without MMSI@ (repeatable)")
+      ->check(CLI::Range(1u, 999999999u));
+  sub->add_option("--speed", args->pub.speed,
+                  "--publish: data time per wall time (1 real time, 20 twenty times faster)")
+      ->check(CLI::Range(0.01, 10000.0))
+      ->capture_default_str();
+  sub->add_flag("--reliable", args->pub.reliable,
+                "--publish: RELIABLE INS and rudder writers (they match best-effort and "
+                "reliable sidecars; a sidecar with reliable_inputs: true needs them)");
+  sub->add_option("--wait-readers", args->pub.wait_readers,
+                  "--publish: wait up to this long for a sidecar's readers before starting [s]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--min-readers", args->pub.min_readers,
+                  "--publish: start once this many INS and rudder readers (sidecars) are matched")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  sub->add_option("--linger", args->pub.linger,
+                  "--publish: keep the writers this long after the last sample [s]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  add_dds_options(sub, &args->dds);
+#else
   sub->add_option("--output", args->output, "output CSV ('-': stdout)")->required();
+#endif
 }
 
 }  // namespace usvfdi::app

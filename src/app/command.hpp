@@ -33,6 +33,9 @@ class CommandRegistry {
     return sub;
   }
 
+  /// The root command line (global options such as --log-level).
+  const CLI::App& root() const { return root_; }
+
   /// After a successful parse: runs the selected subcommand.
   int run_selected() const {
     for (const auto& [sub, run] : commands_) {

@@ -1,7 +1,12 @@
 #include "dds_options.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <fastdds/dds/log/Log.hpp>
+
 #include <csignal>
 #include <ctime>
+#include <memory>
 
 #include "usv_fdi/dds_service/service.hpp"
 
@@ -61,6 +66,34 @@ int wait_for_stop_signal(double timeout_s) {
   ts.tv_nsec = static_cast<long>((timeout_s - static_cast<double>(ts.tv_sec)) * 1e9);
   const int sig = sigtimedwait(&set, nullptr, &ts);
   return sig > 0 ? sig : 0;
+}
+
+namespace {
+
+class SpdlogConsumer : public eprosima::fastdds::dds::LogConsumer {
+ public:
+  void Consume(const eprosima::fastdds::dds::Log::Entry& e) override {
+    using Kind = eprosima::fastdds::dds::Log::Kind;
+    const char* category = e.context.category != nullptr ? e.context.category : "?";
+    switch (e.kind) {
+      case Kind::Error:
+        spdlog::error("Fast DDS [{}] {}", category, e.message);
+        break;
+      case Kind::Warning:
+        spdlog::warn("Fast DDS [{}] {}", category, e.message);
+        break;
+      default:
+        spdlog::debug("Fast DDS [{}] {}", category, e.message);
+        break;
+    }
+  }
+};
+
+}  // namespace
+
+void route_fastdds_log_to_spdlog() {
+  eprosima::fastdds::dds::Log::ClearConsumers();
+  eprosima::fastdds::dds::Log::RegisterConsumer(std::make_unique<SpdlogConsumer>());
 }
 
 }  // namespace usvfdi::app

@@ -35,4 +35,8 @@ void block_stop_signals();
 /// Waits up to timeout_s for SIGINT/SIGTERM; returns the signal number, or 0 on timeout.
 int wait_for_stop_signal(double timeout_s);
 
+/// Routes Fast DDS's own log (by default printed to stdout, where it would corrupt
+/// `monitor --json`) to spdlog on stderr: Error -> error, Warning -> warn, Info -> debug.
+void route_fastdds_log_to_spdlog();
+
 }  // namespace usvfdi::app

@@ -4,6 +4,7 @@
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -19,7 +20,8 @@ using Clock = std::chrono::steady_clock;
 
 int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,
                        const dds::DdsConfig& cfg, const PublishOptions& opt) {
-  block_stop_signals();
+  block_stop_signals();  // before Fast DDS starts its threads
+  route_fastdds_log_to_spdlog();
   if (vessels.empty()) return kExitUsage;
   std::vector<std::unique_ptr<Simulator>> sims;
   try {
@@ -35,44 +37,56 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
-  auto& ins =
-      ctx->create_writer(dds::TopicId::kIns, opt.reliable ? dds::profiles::kInsWriterReliable
-                                                          : dds::profiles::kInsWriterBestEffort);
-  auto& rud = ctx->create_writer(
-      dds::TopicId::kRudder,
-      opt.reliable ? dds::profiles::kRudderWriterReliable : dds::profiles::kRudderWriterBestEffort);
-  // Bounded wait for a sidecar, so the first seconds of the voyage are not lost.
-  const auto wait_end = Clock::now() + std::chrono::duration<double>(opt.wait_readers);
+  eprosima::fastdds::dds::DataWriter* ins = nullptr;
+  eprosima::fastdds::dds::DataWriter* rud = nullptr;
+  try {
+    ins =
+        &ctx->create_writer(dds::TopicId::kIns, opt.reliable ? dds::profiles::kInsWriterReliable
+                                                             : dds::profiles::kInsWriterBestEffort);
+    rud = &ctx->create_writer(dds::TopicId::kRudder, opt.reliable
+                                                         ? dds::profiles::kRudderWriterReliable
+                                                         : dds::profiles::kRudderWriterBestEffort);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return kExitFailure;
+  }
+  // Bounded wait for the sidecars, so that the first seconds of the voyage are not lost.
+  const auto wait_end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(opt.wait_readers));
   eprosima::fastdds::dds::PublicationMatchedStatus mi, mr;
-  while (Clock::now() < wait_end) {
-    ins.get_publication_matched_status(mi);
-    rud.get_publication_matched_status(mr);
-    if (mi.current_count > 0 && mr.current_count > 0) break;
+  for (;;) {
+    ins->get_publication_matched_status(mi);
+    rud->get_publication_matched_status(mr);
+    if ((mi.current_count >= opt.min_readers && mr.current_count >= opt.min_readers) ||
+        Clock::now() >= wait_end) {
+      break;
+    }
     if (wait_for_stop_signal(0.05) != 0) return kExitOk;
   }
-  if (mi.current_count == 0) spdlog::warn("no INS reader matched; publishing anyway");
-  spdlog::info("publishing {} vessel(s) at {:g} Hz, {:g}x real time", vessels.size(),
-               vessels.front().second.rate_hz, opt.speed);
-  const auto t0 = Clock::now();
-  std::uint64_t seq = 0;
+  if (mi.current_count < opt.min_readers || mr.current_count < opt.min_readers) {
+    spdlog::warn(
+        "{} INS / {} rudder reader(s) matched within {:g} s (domain {}, {} wanted); publishing "
+        "anyway",
+        mi.current_count, mr.current_count, opt.wait_readers, cfg.domain_id, opt.min_readers);
+  }
+  spdlog::info("publishing {} vessel(s) at {:g} Hz, {:g}x real time, {} writers", vessels.size(),
+               vessels.front().second.rate_hz, opt.speed,
+               opt.reliable ? "RELIABLE" : "BEST_EFFORT");
+  auto t0 = Clock::now();
+  std::uint64_t seq = 0, failed = 0;
   std::vector<SimRow> rows(sims.size());
-  for (bool more = true; more;) {
+  bool stopped = false;
+  for (bool more = true; more && !stopped;) {
     for (std::size_t i = 0; i < sims.size() && more; ++i) more = sims[i]->next(&rows[i]);
     if (!more) break;
     const double t = rows.front().t;
     std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(t / opt.speed)));
     ++seq;
+    // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp and
+    // releases it as soon as a rudder sample at or after that stamp has arrived.
     for (std::size_t i = 0; i < sims.size(); ++i) {
       const SimRow& r = rows[i];
-      fdi::InsSample s;
-      s.mmsi(vessels[i].first);
-      s.seq(seq);
-      s.stamp(r.t);
-      s.v(r.v);
-      s.r(r.r);
-      s.v_valid(!std::isnan(r.v));  // a missing value is sent as invalid
-      s.r_valid(!std::isnan(r.r));
       fdi::RudderSample d;
       d.mmsi(vessels[i].first);
       d.seq(seq);
@@ -80,17 +94,56 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
       d.delta(r.delta);
       d.valid(std::isfinite(r.delta));
       try {
-        dds::write(rud, d);
-        dds::write(ins, s);
+        dds::write(*rud, d);
       } catch (const std::exception& e) {
-        spdlog::warn("{}", e.what());
+        if (failed++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
       }
     }
-    if (wait_for_stop_signal(0.0) != 0) break;
+    if (seq == 1 && opt.reliable) {
+      // Handshake: the writers' match above is one-sided; a reader acknowledges the first
+      // rudder sample only once it has matched this writer too. So the voyage starts when the
+      // matched sidecars listen (a rudder sample alone starts no INS timeout there). Bounded
+      // by what is left of --wait-readers, at least 1 s.
+      const double left =
+          std::max(1.0, std::chrono::duration<double>(wait_end - Clock::now()).count());
+      if (rud->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left)) !=
+          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+        spdlog::warn("the first rudder sample was not acknowledged within {:g} s", left);
+      }
+      t0 = Clock::now() - std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(t / opt.speed));
+    }
+    for (std::size_t i = 0; i < sims.size(); ++i) {
+      const SimRow& r = rows[i];
+      fdi::InsSample s;
+      s.mmsi(vessels[i].first);
+      s.seq(seq);
+      s.stamp(r.t);
+      // A missing value (stale fault) is sent as invalid; +Inf (invalid fault) as it is.
+      s.v(std::isnan(r.v) ? 0.0 : r.v);
+      s.r(std::isnan(r.r) ? 0.0 : r.r);
+      s.v_valid(!std::isnan(r.v));
+      s.r_valid(!std::isnan(r.r));
+      try {
+        dds::write(*ins, s);
+      } catch (const std::exception& e) {
+        if (failed++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
+      }
+    }
+    if (seq % 1000 == 0) spdlog::debug("t = {:.2f} s", t);
+    stopped = wait_for_stop_signal(0.0) != 0;
   }
-  spdlog::info("published {} samples per vessel", seq);
-  ins.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(opt.linger));
-  std::this_thread::sleep_for(std::chrono::duration<double>(opt.linger));
+  spdlog::info("published {} samples per vessel{}{}", seq, stopped ? " (stopped by a signal)" : "",
+               failed ? ", " + std::to_string(failed) + " writes failed" : std::string());
+  if (!stopped) {
+    // Reliable writers: let the readers acknowledge the tail; then linger (bounded).
+    const eprosima::fastrtps::Duration_t linger(opt.linger);
+    if (opt.reliable) {
+      ins->wait_for_acknowledgments(linger);
+      rud->wait_for_acknowledgments(linger);
+    }
+    (void)wait_for_stop_signal(opt.linger);
+  }
   return kExitOk;
 }
 

@@ -13,7 +13,8 @@ namespace usvfdi::app {
 struct PublishOptions {
   double speed = 1.0;          ///< data time per wall time (2: twice real time)
   bool reliable = false;       ///< RELIABLE writers instead of BEST_EFFORT
-  double wait_readers = 10.0;  ///< wait this long for a matched reader before starting [s]
+  double wait_readers = 10.0;  ///< wait this long for the readers before starting [s]
+  int min_readers = 1;         ///< start once this many INS and rudder readers are matched
   double linger = 1.0;         ///< keep the writers this long after the last sample [s]
 };
 

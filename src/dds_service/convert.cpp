@@ -16,6 +16,7 @@ fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {
   d.threshold(e.threshold);
   d.onset_time(e.onset_time);
   d.detection_time(e.detection_time);
+  d.stamp(e.t);
   d.sequence(e.sequence);
   d.a({e.A(0, 0), e.A(0, 1), e.A(1, 0), e.A(1, 1)});
   d.message(e.message.substr(0, 127).c_str());
@@ -38,6 +39,7 @@ bool from_dds(const fdi::FaultEvent& d, FaultEvent* out) {
   e.threshold = d.threshold();
   e.onset_time = d.onset_time();
   e.detection_time = d.detection_time();
+  e.t = d.stamp();
   e.sequence = d.sequence();
   e.A << d.a()[0], d.a()[1], d.a()[2], d.a()[3];
   e.message = d.message().to_string();

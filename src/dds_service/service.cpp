@@ -1,8 +1,9 @@
 #include "usv_fdi/dds_service/service.hpp"
 
 #include <atomic>
+#include <cstdio>
 #include <stdexcept>
-#include <vector>
+#include <string>
 
 #include "usv_fdi/dds_service/convert.hpp"
 
@@ -12,44 +13,50 @@ namespace dds = usv_fdi::dds;
 using eprosima::fastdds::dds::DataReader;
 using eprosima::fastdds::dds::DataReaderListener;
 using eprosima::fastdds::dds::StatusMask;
+using eprosima::fastrtps::types::ReturnCode_t;
 
 /// Reader listener: copies this vessel's samples into the pipeline's input queue, nothing else
-/// (no I/O, no locks held across calls; the queue never blocks).
+/// (no I/O, no lock of ours; the queue never blocks). Samples of other vessels (same topic,
+/// other MMSI) are counted and skipped. Fast DDS may call it from several of its threads at
+/// once (one per transport), so it keeps no state but atomics.
 class FdiService::Listener : public DataReaderListener {
  public:
   Listener(FdiPipeline* p, std::uint32_t mmsi) : p_(p), mmsi_(mmsi) {}
   void on_data_available(DataReader* reader) override {
     if (reader == ins_) {
-      ins_buf_.clear();
-      dds::take_all(*reader, ins_buf_);
-      for (const auto& s : ins_buf_) {
-        if (s.mmsi() == mmsi_) p_->push_ins(from_dds(s));
-      }
+      drain<fdi::InsSample>(*reader,
+                            [this](const fdi::InsSample& s) { return p_->push_ins(from_dds(s)); });
     } else if (reader == rudder_) {
-      rudder_buf_.clear();
-      dds::take_all(*reader, rudder_buf_);
-      for (const auto& s : rudder_buf_) {
-        if (s.mmsi() == mmsi_) p_->push_rudder(from_dds(s));
-      }
+      drain<fdi::RudderSample>(
+          *reader, [this](const fdi::RudderSample& s) { return p_->push_rudder(from_dds(s)); });
     } else if (reader == ack_) {
-      ack_buf_.clear();
-      dds::take_all(*reader, ack_buf_);
-      for (const auto& a : ack_buf_) {
-        if (a.mmsi() == mmsi_) p_->push_ack(from_dds(a));
-      }
+      drain<fdi::FaultAck>(*reader,
+                           [this](const fdi::FaultAck& a) { return p_->push_ack(from_dds(a)); });
     }
   }
   DataReader* ins_ = nullptr;
   DataReader* rudder_ = nullptr;
   DataReader* ack_ = nullptr;
+  std::atomic<std::uint64_t> foreign{0};  ///< samples of other vessels, skipped
 
  private:
+  template <class T, class Push>
+  void drain(DataReader& reader, Push push) {
+    T sample;
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader.take_next_sample(&sample, &info) ==
+           eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      if (sample.mmsi() != mmsi_) {
+        foreign.fetch_add(1, std::memory_order_relaxed);
+        continue;
+      }
+      push(sample);  // a full queue drops its oldest element and counts it
+    }
+  }
+
   FdiPipeline* p_;
   std::uint32_t mmsi_;
-  // Each reader's callbacks are serialised by Fast DDS; one buffer per reader.
-  std::vector<fdi::InsSample> ins_buf_;
-  std::vector<fdi::RudderSample> rudder_buf_;
-  std::vector<fdi::FaultAck> ack_buf_;
 };
 
 FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(std::move(log)) {
@@ -62,10 +69,12 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   auto on_event = [this, mmsi](const FaultEvent& e) {
     dds::write(*event_writer_, to_dds(e, mmsi));
     if (log_) {
-      log_(1, std::string("event #") + std::to_string(e.sequence) + " " + to_string(e.sensor) +
-                  " " + to_string(e.state) + " kind=" + to_string(e.kind) +
-                  " C_a=" + std::to_string(e.c_a) + " C_g=" + std::to_string(e.c_g) +
-                  " t=" + std::to_string(e.t) + ": " + e.message);
+      char head[192];
+      std::snprintf(head, sizeof head,
+                    "fault event MMSI %u %s #%llu %s kind=%s C_a=%.3f C_g=%.3f t=%.2f s", mmsi,
+                    to_string(e.sensor), static_cast<unsigned long long>(e.sequence),
+                    to_string(e.state), to_string(e.kind), e.c_a, e.c_g, e.t);
+      log_(1, std::string(head) + ": " + e.message);
     }
   };
   auto on_status = [this, mmsi, iso](const PipelineStatus& s) {
@@ -86,6 +95,26 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
 }
 
 FdiService::~FdiService() { stop(); }
+
+FdiService::Matches FdiService::matches() const {
+  Matches m;
+  if (stopped_ || !dds_) return m;
+  eprosima::fastdds::dds::SubscriptionMatchedStatus sub;
+  eprosima::fastdds::dds::PublicationMatchedStatus pub;
+  if (listener_->ins_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
+    m.ins_writers = sub.current_count;
+  if (listener_->rudder_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
+    m.rudder_writers = sub.current_count;
+  if (listener_->ack_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
+    m.ack_writers = sub.current_count;
+  if (event_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
+    m.event_readers = pub.current_count;
+  if (status_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
+    m.status_readers = pub.current_count;
+  return m;
+}
+
+std::uint64_t FdiService::foreign_samples() const { return listener_->foreign.load(); }
 
 void FdiService::start() {
   pipeline_->start();

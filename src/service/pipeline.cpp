@@ -100,6 +100,11 @@ void FdiPipeline::stop() {
   if (iso_thread_.joinable()) iso_thread_.join();
   ident_q_.shutdown();
   if (ident_thread_.joinable()) ident_thread_.join();
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(opt_.stop_drain_timeout));
+  drain_deadline_ns_ =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(deadline.time_since_epoch()).count();
   output_.shutdown();
   if (pub_thread_.joinable()) pub_thread_.join();
 }
@@ -179,15 +184,23 @@ PipelineStatus FdiPipeline::make_status() const {
   st.rejected = rejected_.load();
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
-  st.dropped_output = output_.dropped();
+  st.dropped_output = output_.dropped() + dropped_at_stop_.load();
   st.ins_silent = ins_silent_.load();
   st.rudder_missing = !st.isolation.input.delta_ok;
   return st;
 }
 
 PipelineStatus FdiPipeline::status() const {
-  std::lock_guard<std::mutex> lock(snap_m_);
-  return last_status_;
+  PipelineStatus st;
+  {
+    std::lock_guard<std::mutex> lock(snap_m_);
+    st = last_status_;
+  }
+  // The counters are read live (the snapshot is refreshed at the status period only).
+  st.dropped_inputs = input_.dropped();
+  st.dropped_ident = ident_q_.dropped();
+  st.dropped_output = output_.dropped() + dropped_at_stop_.load();
+  return st;
 }
 
 void FdiPipeline::isolation_loop() {
@@ -280,6 +293,13 @@ void FdiPipeline::identification_loop() {
 void FdiPipeline::publisher_loop() {
   Output o;
   while (output_.pop(&o)) {
+    const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                    std::chrono::steady_clock::now().time_since_epoch())
+                                    .count();
+    if (now_ns > drain_deadline_ns_.load()) {
+      ++dropped_at_stop_;  // stop() is waiting: never block shutdown on a slow writer
+      continue;
+    }
     try {
       if (const auto* ev = std::get_if<FaultEvent>(&o)) {
         if (on_event_) on_event_(*ev);
@@ -289,6 +309,10 @@ void FdiPipeline::publisher_loop() {
     } catch (const std::exception& e) {
       log(3, std::string("publishing failed: ") + e.what());
     }
+  }
+  if (dropped_at_stop_.load() > 0) {
+    log(2, std::to_string(dropped_at_stop_.load()) +
+               " queued events/status not published: the writer was too slow at stop");
   }
 }
 

@@ -15,6 +15,11 @@
 //       instance mmsi=.. sensor=.. state=.. kind=.. sequence=.. samples=.. message=..
 //     and exits 0; exits 1 on timeout (after printing what it has).
 //
+//   usv_fdi_dds_probe writer-qos --profiles FILE --writer-profile NAME
+//     Joins the domain as the service does (FASTRTPS_DEFAULT_PROFILES_FILE first, then FILE)
+//     and prints the data writer profile's QoS as
+//       reliability=R durability=D depth=N max_instances=M
+//
 // Exit code 3: usage error; 4: DDS error.
 #include <atomic>
 #include <chrono>
@@ -32,6 +37,7 @@
 
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
 #include "usv_fdi/dds/dds_context.hpp"
 
@@ -59,6 +65,7 @@ struct Options {
   double timeout_s = 30.0;
   unsigned expect = 0;
   unsigned settle_ms = 300;
+  std::string writer_profile;
 };
 
 struct UsageError : std::runtime_error {
@@ -77,10 +84,10 @@ unsigned long parse_unsigned(const std::string& flag, const std::string& value) 
 }
 
 Options parse(int argc, char** argv) {
-  if (argc < 2) throw UsageError("missing mode (publish-faults | read-faults)");
+  if (argc < 2) throw UsageError("missing mode (publish-faults | read-faults | writer-qos)");
   Options o;
   o.mode = argv[1];
-  if (o.mode != "publish-faults" && o.mode != "read-faults") {
+  if (o.mode != "publish-faults" && o.mode != "read-faults" && o.mode != "writer-qos") {
     throw UsageError("unknown mode '" + o.mode + "'");
   }
   for (int i = 2; i < argc; ++i) {
@@ -115,6 +122,8 @@ Options parse(int argc, char** argv) {
       }
     } else if (flag == "--expect") {
       o.expect = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--writer-profile") {
+      o.writer_profile = value;
     } else if (flag == "--settle-ms") {
       o.settle_ms = static_cast<unsigned>(parse_unsigned(flag, value));
     } else {
@@ -240,11 +249,27 @@ int read_faults(const Options& o) {
   return 0;
 }
 
+int writer_qos(const Options& o) {
+  if (o.writer_profile.empty()) throw UsageError("--writer-profile is required");
+  DdsContext ctx(o.dds);  // loads the profiles exactly as the service does
+  fdds::DataWriterQos q;
+  if (ctx.publisher().get_datawriter_qos_from_profile(o.writer_profile, q) !=
+      eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+    std::fprintf(stderr, "writer-qos: no data writer profile '%s'\n", o.writer_profile.c_str());
+    return 4;
+  }
+  std::printf("reliability=%d durability=%d depth=%d max_instances=%d\n",
+              static_cast<int>(q.reliability().kind), static_cast<int>(q.durability().kind),
+              q.history().depth, q.resource_limits().max_instances);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
+    if (o.mode == "writer-qos") return writer_qos(o);
     return o.mode == "publish-faults" ? publish_faults(o) : read_faults(o);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "usv_fdi_dds_probe: %s\n", e.what());

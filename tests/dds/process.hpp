@@ -1,5 +1,6 @@
-// Minimal child-process helper for the DDS tests: posix_spawn with stdout on a pipe, bounded
-// waits everywhere, SIGKILL + reap on destruction so a failing test never leaves a process behind.
+// Minimal child-process helper for the DDS tests: fork/exec with stdout on a pipe, bounded
+// waits everywhere, SIGKILL + reap on destruction, and PR_SET_PDEATHSIG so that a child dies
+// with the test even when the test process itself is killed: no test leaves a process behind.
 #pragma once
 
 #include <sys/types.h>
@@ -13,8 +14,11 @@ namespace usv_fdi::dds::test {
 
 class ChildProcess {
  public:
-  /// Spawns argv[0] with the given arguments; stdout is captured, stderr is inherited.
-  explicit ChildProcess(const std::vector<std::string>& argv);
+  /// Spawns argv[0] with the given arguments; stdout is captured. stderr goes to
+  /// `stderr_path` (created/truncated) if given, else it is inherited. `extra_env` entries
+  /// ("NAME=value") are added to (or override) this process's environment.
+  explicit ChildProcess(const std::vector<std::string>& argv, const std::string& stderr_path = "",
+                        const std::vector<std::string>& extra_env = {});
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;

@@ -5,6 +5,8 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -165,6 +167,58 @@ TEST(LateJoinerTest, PublisherExitsOnSigint) {
   const auto code = publisher.wait_exit(milliseconds(2000));
   ASSERT_TRUE(code.has_value());
   EXPECT_EQ(*code, 0);
+}
+
+}  // namespace
+}  // namespace usv_fdi::dds::test
+
+namespace usv_fdi::dds::test {
+namespace {
+
+// A deployment overrides any shipped QoS profile through FASTRTPS_DEFAULT_PROFILES_FILE,
+// without editing config/qos/usv_fdi_profiles.xml: that file is loaded first and its
+// profiles win for the same name. Checked in a child process (the default profiles are loaded
+// once per process).
+TEST(XmlProfiles, DefaultProfilesFileOverridesAShippedProfile) {
+  const std::string override_xml =
+      ::testing::TempDir() + "usv_fdi_override_" + std::to_string(::getpid()) + ".xml";
+  {
+    std::ofstream f(override_xml);
+    f << R"(<?xml version="1.0" encoding="UTF-8" ?>
+<dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <profiles>
+    <data_writer profile_name="usv_fdi_status_writer">
+      <topic>
+        <historyQos><kind>KEEP_LAST</kind><depth>3</depth></historyQos>
+        <resourceLimitsQos>
+          <max_samples>300</max_samples>
+          <max_instances>100</max_instances>
+          <max_samples_per_instance>3</max_samples_per_instance>
+        </resourceLimitsQos>
+      </topic>
+      <qos><durability><kind>VOLATILE</kind></durability></qos>
+    </data_writer>
+  </profiles>
+</dds>)";
+  }
+  auto qos_of = [&](const std::vector<std::string>& env) {
+    ChildProcess p({kProbe, "writer-qos", "--profiles", kProfilesFile, "--domain",
+                    std::to_string(test_domain_id()), "--participant-profile",
+                    profiles::kParticipantLoopback, "--writer-profile", profiles::kStatusWriter},
+                   "", env);
+    const std::string out = p.read_all(std::chrono::milliseconds(10000));
+    EXPECT_EQ(p.wait_exit(std::chrono::milliseconds(5000)).value_or(-1), 0) << out;
+    return out;
+  };
+  // Shipped: TRANSIENT_LOCAL (1), KEEP_LAST 1, 4096 instances.
+  EXPECT_EQ(qos_of({}), "reliability=2 durability=1 depth=1 max_instances=4096\n");
+  // (Fast DDS also logs "Error adding profile 'usv_fdi_status_writer'" when our file repeats
+  // the name: expected, the first definition stays.)
+  const std::string overridden = qos_of({"FASTRTPS_DEFAULT_PROFILES_FILE=" + override_xml});
+  EXPECT_NE(overridden.find("reliability=2 durability=0 depth=3 max_instances=100\n"),
+            std::string::npos)
+      << overridden;
+  std::remove(override_xml.c_str());
 }
 
 }  // namespace

@@ -132,20 +132,40 @@ TEST(FdiPipeline, PaperScenarioThroughTheThreadsRaisesBothFaults) {
     if (!(k % 2)) p.push_rudder({r.t, r.delta, true});
   }
   p.stop();
-  // THEN a gyro fault and an accelerometer fault were raised and cleared, nothing else
+  // THEN a gyro fault and an accelerometer fault were raised (isolated) and cleared, nothing
+  // else (kind refinements of a raised fault, same state, are not state changes). Times with
+  // tolerances: the core's numerics may change.
+  std::vector<FaultEvent> changes;
+  for (const FaultEvent& e : c.events) {
+    const bool refinement =
+        !changes.empty() && changes.back().sensor == e.sensor && changes.back().state == e.state;
+    if (!refinement) changes.push_back(e);
+  }
   std::vector<std::pair<Sensor, FaultState>> seen;
-  for (const FaultEvent& e : c.events) seen.emplace_back(e.sensor, e.state);
+  for (const FaultEvent& e : changes) seen.emplace_back(e.sensor, e.state);
   const std::vector<std::pair<Sensor, FaultState>> want = {
       {Sensor::kGyro, FaultState::kRaised},
       {Sensor::kGyro, FaultState::kClearedUnacknowledged},
       {Sensor::kAccelerometer, FaultState::kRaised},
       {Sensor::kAccelerometer, FaultState::kClearedUnacknowledged}};
-  EXPECT_EQ(seen, want);
-  ASSERT_EQ(c.events.size(), 4u);
-  EXPECT_GT(c.events[0].t, 20.0);
-  EXPECT_LT(c.events[0].t, 21.0);
-  EXPECT_GT(c.events[2].t, 60.0);
-  EXPECT_LT(c.events[2].t, 61.0);
+  ASSERT_EQ(seen, want);
+  EXPECT_GT(changes[0].t, 20.0);
+  EXPECT_LT(changes[0].t, 23.0);
+  EXPECT_GE(changes[0].c_g, 0.8);
+  EXPECT_LE(changes[0].c_a, 0.2);
+  EXPECT_GT(changes[1].t, 40.0);
+  EXPECT_LT(changes[1].t, 45.0);
+  EXPECT_GT(changes[2].t, 60.0);
+  EXPECT_LT(changes[2].t, 63.0);
+  EXPECT_GE(changes[2].c_a, 0.8);
+  EXPECT_LE(changes[2].c_g, 0.2);
+  EXPECT_GT(changes[3].t, 80.0);
+  EXPECT_LT(changes[3].t, 85.0);
+  for (std::size_t i = 1; i < c.events.size(); ++i) {
+    if (c.events[i].sensor == c.events[i - 1].sensor) {
+      EXPECT_GT(c.events[i].sequence, c.events[i - 1].sequence);
+    }
+  }
   EXPECT_EQ(p.status().dropped_inputs, 0u);
   EXPECT_EQ(p.status().rejected, 0u);
 }

@@ -46,8 +46,24 @@ class FdiService {
 
   void start();
   /// Stops the listeners' feed, drains and joins the threads, deletes the DDS entities.
+  /// Idempotent; the destructor calls it.
   void stop();
   PipelineStatus status() const { return pipeline_->status(); }
+
+  /// Matched remote endpoints (for the operator's log); all zero after stop().
+  struct Matches {
+    int ins_writers = 0, rudder_writers = 0, ack_writers = 0;
+    int event_readers = 0, status_readers = 0;
+    bool operator==(const Matches& o) const {
+      return ins_writers == o.ins_writers && rudder_writers == o.rudder_writers &&
+             ack_writers == o.ack_writers && event_readers == o.event_readers &&
+             status_readers == o.status_readers;
+    }
+    bool operator!=(const Matches& o) const { return !(*this == o); }
+  };
+  Matches matches() const;
+  /// Samples on the input topics that carried another vessel's MMSI (skipped).
+  std::uint64_t foreign_samples() const;
 
  private:
   class Listener;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <climits>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -74,6 +75,9 @@ struct PipelineOptions {
   double input_timeout = 1.0;          ///< INS silent this long (wall clock): stale [s]
   double status_period = 1.0;          ///< FdiStatus period (wall clock) [s]
   double snapshot_period = 0.2;        ///< estimate snapshots (source time) [s]
+  /// stop(): events and status still queued for the sink are handed over for at most this
+  /// long (wall clock); what is left after it is dropped and counted (dropped_output) [s].
+  double stop_drain_timeout = 0.5;
   /// Blocking mode: the isolation thread waits for the identification thread after each
   /// sample, so results do not depend on scheduling (replay at full speed, tests).
   bool lockstep = false;
@@ -89,7 +93,7 @@ struct PipelineStatus {
   std::uint64_t samples = 0;         ///< samples assembled
   std::uint64_t dropped_inputs = 0;  ///< input queue overflow
   std::uint64_t dropped_ident = 0;   ///< identification queue overflow
-  std::uint64_t dropped_output = 0;  ///< output queue overflow
+  std::uint64_t dropped_output = 0;  ///< output queue overflow, and events left at stop()
   std::uint64_t rejected = 0;        ///< samples the engine refused (time not increasing)
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
@@ -177,6 +181,10 @@ class FdiPipeline {
   std::condition_variable step_cv_;
   std::uint64_t ident_pushed_ = 0, ident_done_ = 0;
   std::atomic<bool> ins_silent_{false};
+  /// Set by stop() before the output queue shuts down: the publisher thread drops (and
+  /// counts) what it cannot hand over before this steady_clock time (ns since its epoch).
+  std::atomic<std::int64_t> drain_deadline_ns_{INT64_MAX};
+  std::atomic<std::uint64_t> dropped_at_stop_{0};
   std::thread iso_thread_, ident_thread_, pub_thread_;
   bool started_ = false, stopped_ = false;
 };

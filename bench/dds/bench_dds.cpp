@@ -1,0 +1,600 @@
+// Benchmark of the usv-fdi DDS sidecar (issue 3), not a test: prints medians, percentiles
+// and ratios measured side by side in one run.
+//
+//   usv_fdi_bench_dds [--faults N] [--block B] [--cpu-seconds S] [--rate HZ] [--domain D]
+//                     [--participant-profile P] [--skip-latency] [--skip-cpu]
+//
+// 1. Latency. Two responders run as separate processes on loopback (UDPv4 127.0.0.1,
+//    participant profile usv_fdi_participant_loopback), each on its own partition:
+//      * the real sidecar, `usv-fdi run` (Otter engine settings; isolation.invalid_count 1,
+//        spike_window 0.1 s, so one absurd INS value raises an `invalid` accelerometer fault
+//        on that very sample, and 0.12 s of plausible samples clear it again);
+//      * `usv_fdi_bench_dds echo`: a plain Fast DDS participant whose INS listener writes a
+//        FaultEvent of the same size with the same QoS profiles, straight from the callback.
+//    The driver writes rudder(t) then INS(t) with v = 1000 m/s and times the write of the INS
+//    sample to the take() of the FaultEvent (state raised, stamp t) at its own reader (same
+//    process, steady clock); then it writes 6 plausible samples and (sidecar) waits for the
+//    clear. Faults go in interleaved blocks of B to the sidecar and to the echo so that both
+//    see the same machine load. The first block of each is warm-up and not counted.
+//    Reported: p50/p90/p99/max per path, and sidecar minus echo (added latency).
+// 2. CPU and RSS. A fresh sidecar (default Otter settings) and a fresh echo both subscribe to
+//    one stream of simulated Otter data (autopilot, realistic noise) at HZ (default 100) in
+//    real time. CPU = (utime+stime) over S seconds after a 5 s warm-up, from /proc/<pid>/stat;
+//    RSS = VmRSS at the end and VmHWM, from /proc/<pid>/status.
+//
+// Exit code 0 when it completed (targets are reported, not enforced), 1 on error.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "usv_fdi/core/simulator.hpp"
+#include "usv_fdi/core/vessel.hpp"
+#include "usv_fdi/dds/dds_context.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace dds = usv_fdi::dds;
+namespace fdds = eprosima::fastdds::dds;
+using eprosima::fastrtps::types::ReturnCode_t;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::uint32_t kMmsi = 257999001;
+constexpr double kAbsurd = 1000.0;  // [m/s] > isolation.max_abs_v
+const char* const kInvalidMessage = "accelerometer channel v: repeated non-finite or absurd values";
+
+struct Options {
+  int faults = 1000;
+  int block = 50;
+  double cpu_seconds = 60.0;
+  double rate = 100.0;
+  std::uint32_t domain = 1 + static_cast<std::uint32_t>(::getpid()) % 200;
+  std::string participant = dds::profiles::kParticipantLoopback;
+  bool latency = true;
+  bool cpu = true;
+  // echo mode
+  std::string partition;
+};
+
+dds::DdsConfig dds_config(const Options& o, const std::string& partition) {
+  dds::DdsConfig c;
+  c.profiles_file = USV_FDI_QOS_PROFILES;
+  c.domain_id = o.domain;
+  c.participant_profile = o.participant;
+  c.publisher_partitions = {partition};
+  c.subscriber_partitions = {partition};
+  return c;
+}
+
+// ------------------------------------------------------------------ echo (plain DDS)
+
+/// Writes a raised FaultEvent for an absurd INS value and a cleared one for the first plausible
+/// sample after it, from the listener callback: the plain Fast DDS round trip.
+class Echo : public fdds::DataReaderListener {
+ public:
+  explicit Echo(fdds::DataWriter* w) : w_(w) {}
+  void on_data_available(fdds::DataReader* r) override {
+    fdi::InsSample s;
+    fdds::SampleInfo info;
+    while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const bool absurd = std::abs(s.v()) > 20.0;
+      if (!absurd && !raised_) continue;
+      fdi::FaultEvent e;
+      e.mmsi(s.mmsi());
+      e.sensor(0);
+      e.state(absurd ? 1 : 3);
+      e.kind(8);
+      e.detection_time(s.stamp());
+      e.onset_time(s.stamp());
+      e.stamp(s.stamp());
+      e.sequence(++seq_);
+      e.message(kInvalidMessage);
+      raised_ = absurd;
+      dds::write(*w_, e);
+    }
+  }
+
+ private:
+  fdds::DataWriter* w_;
+  bool raised_ = false;  // one INS reader: Fast DDS serialises its callbacks per reader
+  std::uint64_t seq_ = 0;
+};
+
+int run_echo(const Options& o) {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  dds::DdsContext ctx(dds_config(o, o.partition));
+  fdds::DataWriter& w =
+      ctx.create_writer(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventWriter);
+  Echo echo(&w);
+  ctx.create_reader(dds::TopicId::kRudder, dds::profiles::kRudderReaderBestEffort);
+  ctx.create_reader(dds::TopicId::kIns, dds::profiles::kInsReaderBestEffort, &echo,
+                    fdds::StatusMask::data_available());
+  std::printf("echo ready\n");
+  std::fflush(stdout);
+  int sig = 0;
+  while (sig <= 0) {
+    timespec ts{1, 0};
+    sig = sigtimedwait(&set, nullptr, &ts);
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------ child processes
+
+class Child {
+ public:
+  explicit Child(const std::vector<std::string>& argv, const std::string& log) {
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    const pid_t parent = ::getpid();
+    pid_ = ::fork();
+    if (pid_ < 0) throw std::runtime_error("cannot fork for " + argv[0]);
+    if (pid_ == 0) {
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // never outlive the benchmark
+      if (::getppid() != parent) ::_exit(127);
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (fd >= 0) {
+        ::dup2(fd, STDOUT_FILENO);
+        ::dup2(fd, STDERR_FILENO);
+      }
+      ::execve(args[0], args.data(), environ);
+      ::_exit(127);
+    }
+  }
+  ~Child() { stop(); }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  pid_t pid() const { return pid_; }
+  /// SIGTERM, then SIGKILL after 3 s.
+  void stop() {
+    if (pid_ <= 0) return;
+    ::kill(pid_, SIGTERM);
+    int status = 0;
+    for (int i = 0; i < 300; ++i) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
+}
+
+bool wait_for_text(const std::string& path, const std::string& text, double seconds) {
+  const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+  while (Clock::now() < end) {
+    if (slurp(path).find(text) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+struct ProcUsage {
+  double cpu_s = 0;  ///< utime + stime [s]
+  double rss_mb = 0, hwm_mb = 0;
+};
+
+ProcUsage usage(pid_t pid) {
+  ProcUsage u;
+  {
+    std::ifstream f("/proc/" + std::to_string(pid) + "/stat");
+    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const auto close = text.rfind(')');  // comm may contain spaces
+    std::istringstream in(text.substr(close + 2));
+    std::string field;
+    std::vector<std::string> fields;
+    while (in >> field) fields.push_back(field);
+    // fields[0] is field 3 (state); utime = field 14, stime = field 15.
+    if (fields.size() > 13) {
+      u.cpu_s = (std::stod(fields[11]) + std::stod(fields[12])) /
+                static_cast<double>(sysconf(_SC_CLK_TCK));
+    }
+  }
+  std::ifstream f("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(f, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) u.rss_mb = std::stod(line.substr(6)) / 1024.0;
+    if (line.rfind("VmHWM:", 0) == 0) u.hwm_mb = std::stod(line.substr(6)) / 1024.0;
+  }
+  return u;
+}
+
+// ------------------------------------------------------------------ driver side
+
+/// INS + rudder writers and a FaultEvent reader on one partition.
+class Endpoint {
+ public:
+  Endpoint(const Options& o, const std::string& partition)
+      : ctx_(std::make_unique<dds::DdsContext>(dds_config(o, partition))) {
+    ins_ = &ctx_->create_writer(dds::TopicId::kIns, dds::profiles::kInsWriterBestEffort);
+    rud_ = &ctx_->create_writer(dds::TopicId::kRudder, dds::profiles::kRudderWriterBestEffort);
+    ev_ = &ctx_->create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
+    ev_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+    ws_.attach_condition(ev_->get_statuscondition());
+  }
+
+  bool matched(double seconds) {
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    while (Clock::now() < end) {
+      fdds::PublicationMatchedStatus a, b;
+      fdds::SubscriptionMatchedStatus c;
+      ins_->get_publication_matched_status(a);
+      rud_->get_publication_matched_status(b);
+      ev_->get_subscription_matched_status(c);
+      if (a.current_count > 0 && b.current_count > 0 && c.current_count > 0) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+  /// Writes rudder(t) then INS(t); returns the time just before the INS write.
+  Clock::time_point write(double t, double v, double r, double delta) {
+    fdi::RudderSample d;
+    d.mmsi(kMmsi);
+    d.seq(++seq_);
+    d.stamp(t);
+    d.delta(delta);
+    d.valid(true);
+    dds::write(*rud_, d);
+    fdi::InsSample s;
+    s.mmsi(kMmsi);
+    s.seq(seq_);
+    s.stamp(t);
+    s.v(v);
+    s.r(r);
+    s.v_valid(true);
+    s.r_valid(true);
+    const auto t0 = Clock::now();
+    dds::write(*ins_, s);
+    return t0;
+  }
+
+  /// Waits for a FaultEvent with this state and stamp; returns its receipt time.
+  bool wait_event(std::uint8_t state, double stamp, double timeout_s, Clock::time_point* at) {
+    const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+    fdi::FaultEvent e;
+    fdds::SampleInfo info;
+    for (;;) {
+      while (ev_->take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) {
+        if (info.valid_data && e.state() == state && (stamp < 0 || e.stamp() == stamp)) {
+          *at = Clock::now();
+          return true;
+        }
+      }
+      const auto left = std::chrono::duration<double>(end - Clock::now()).count();
+      if (left <= 0) return false;
+      fdds::ConditionSeq active;
+      ws_.wait(active, eprosima::fastrtps::Duration_t(std::min(left, 0.5)));
+    }
+  }
+
+  void drain() {
+    fdi::FaultEvent e;
+    fdds::SampleInfo info;
+    while (ev_->take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) {
+    }
+  }
+
+ private:
+  std::unique_ptr<dds::DdsContext> ctx_;
+  fdds::DataWriter *ins_ = nullptr, *rud_ = nullptr;
+  fdds::DataReader* ev_ = nullptr;
+  fdds::WaitSet ws_;
+  std::uint64_t seq_ = 0;
+};
+
+/// Plausible Otter data (autopilot, realistic noise), endless.
+class Voyage {
+ public:
+  explicit Voyage(double rate) {
+    usvfdi::VesselModel v;
+    if (!usvfdi::find_vessel("otter", &v)) throw std::runtime_error("no otter model");
+    usvfdi::SimConfig c;
+    c.vessel = v;
+    c.rate_hz = rate;
+    c.duration = 1e9;
+    c.steering = usvfdi::Steering::kAutopilot;
+    sim_ = std::make_unique<usvfdi::Simulator>(c);
+  }
+  usvfdi::SimRow next() {
+    usvfdi::SimRow r;
+    sim_->next(&r);
+    return r;
+  }
+
+ private:
+  std::unique_ptr<usvfdi::Simulator> sim_;
+};
+
+double pct(std::vector<double> x, double p) {
+  if (x.empty()) return NAN;
+  std::sort(x.begin(), x.end());
+  const double k = p / 100.0 * static_cast<double>(x.size() - 1);
+  const auto i = static_cast<std::size_t>(std::floor(k));
+  const double f = k - static_cast<double>(i);
+  return i + 1 < x.size() ? x[i] * (1 - f) + x[i + 1] * f : x[i];
+}
+
+/// The sidecar's config: the Otter's engine settings (config/vessels/otter.yaml) and a service
+/// section. For the latency run, isolation.invalid_count 1 and spike_window 0.1 s make one
+/// absurd value raise an `invalid` fault at once and 0.1 s of plausible values clear it.
+std::string write_service_config(const std::string& dir, const std::string& name,
+                                 bool invalid_raises_at_once) {
+  const std::string path = dir + "/" + name + ".yaml";
+  std::ofstream f(path);
+  std::string otter = slurp(std::string(USV_FDI_SOURCE_DIR) + "/config/vessels/otter.yaml");
+  if (invalid_raises_at_once) {
+    const auto at = otter.find("isolation:\n");
+    if (at == std::string::npos) throw std::runtime_error("otter.yaml has no isolation section");
+    otter.insert(at + 11, "  invalid_count: 1\n  spike_window: 0.1\n");
+  }
+  f << otter << "\nservice:\n  mmsi: " << kMmsi << "\n  status_rate: 1\n";
+  if (invalid_raises_at_once) f << "  input_timeout: 60\n";
+  if (!f) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+int run_driver(const Options& o, const char* self) {
+  char tmpl[] = "/tmp/usv_fdi_bench_dds_XXXXXX";
+  if (mkdtemp(tmpl) == nullptr) throw std::runtime_error("mkdtemp failed");
+  const std::string dir = tmpl;
+  const std::string domain = std::to_string(o.domain);
+  const std::string tag = std::to_string(::getpid());
+  auto common = [&](const std::string& partition) {
+    return std::vector<std::string>{
+        "--domain", domain, "--partition", partition, "--participant-profile", o.participant};
+  };
+  std::printf("usv-fdi DDS benchmark: domain %s, participant profile %s, logs in %s\n",
+              domain.c_str(), o.participant.c_str(), dir.c_str());
+  std::fflush(stdout);
+
+  if (o.latency) {
+    const std::string p_svc = "bench_svc_" + tag, p_echo = "bench_echo_" + tag;
+    std::vector<std::string> svc_args = {USV_FDI_EXE, "run", "--config",
+                                         write_service_config(dir, "latency", true)};
+    for (const auto& a : common(p_svc)) svc_args.push_back(a);
+    Child svc(svc_args, dir + "/latency_sidecar.log");
+    std::vector<std::string> echo_args = {self, "echo"};
+    for (const auto& a : common(p_echo)) echo_args.push_back(a);
+    Child echo(echo_args, dir + "/latency_echo.log");
+    if (!wait_for_text(dir + "/latency_sidecar.log", "waiting for INS", 15) ||
+        !wait_for_text(dir + "/latency_echo.log", "echo ready", 15)) {
+      std::fprintf(stderr, "responders did not start; see %s\n", dir.c_str());
+      return 1;
+    }
+    Endpoint to_svc(o, p_svc), to_echo(o, p_echo);
+    if (!to_svc.matched(15) || !to_echo.matched(15)) {
+      std::fprintf(stderr, "no match with the responders; see %s\n", dir.c_str());
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    Voyage voyage(50.0);
+    double t_svc = 0.0, t_echo = 0.0;
+    std::vector<double> lat_svc, lat_echo;
+    int lost_svc = 0, lost_echo = 0;
+    const auto run_block = [&](Endpoint& ep, double* t, std::vector<double>* out, int* lost,
+                               bool sidecar, bool count) {
+      for (int k = 0; k < o.block; ++k) {
+        usvfdi::SimRow row = voyage.next();
+        *t += 0.02;
+        const auto t0 = ep.write(*t, kAbsurd, row.r, row.delta);
+        Clock::time_point t1;
+        if (ep.wait_event(1, *t, 2.0, &t1)) {
+          if (count) out->push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+        } else {
+          ++*lost;
+        }
+        for (int j = 0; j < 6; ++j) {  // 0.12 s of plausible data clears the fault
+          row = voyage.next();
+          *t += 0.02;
+          ep.write(*t, row.v, row.r, row.delta);
+        }
+        if (sidecar) {
+          Clock::time_point ignored;
+          if (!ep.wait_event(3, -1, 2.0, &ignored)) ++*lost;
+        } else {
+          std::this_thread::sleep_for(std::chrono::microseconds(200));
+          ep.drain();
+        }
+      }
+    };
+    run_block(to_svc, &t_svc, &lat_svc, &lost_svc, true, false);  // warm-up
+    run_block(to_echo, &t_echo, &lat_echo, &lost_echo, false, false);
+    const auto t_start = Clock::now();
+    while (static_cast<int>(lat_svc.size()) < o.faults ||
+           static_cast<int>(lat_echo.size()) < o.faults) {
+      run_block(to_svc, &t_svc, &lat_svc, &lost_svc, true, true);
+      run_block(to_echo, &t_echo, &lat_echo, &lost_echo, false, true);
+      if (lost_svc + lost_echo > o.faults / 10) {
+        std::fprintf(stderr, "too many lost faults (sidecar %d, echo %d); see %s\n", lost_svc,
+                     lost_echo, dir.c_str());
+        return 1;
+      }
+    }
+    const double took = std::chrono::duration<double>(Clock::now() - t_start).count();
+    std::printf("\n1. End-to-end latency, INS sample write -> FaultEvent take at the subscriber\n");
+    std::printf(
+        "   (%zu faults per path in interleaved blocks of %d, %.1f s; not received: "
+        "sidecar %d, echo %d)\n",
+        lat_svc.size(), o.block, took, lost_svc, lost_echo);
+    std::printf("   %-34s %9s %9s %9s %9s\n", "path [us]", "p50", "p90", "p99", "max");
+    std::printf("   %-34s %9.1f %9.1f %9.1f %9.1f\n", "usv-fdi run (sidecar)", pct(lat_svc, 50),
+                pct(lat_svc, 90), pct(lat_svc, 99), pct(lat_svc, 100));
+    std::printf("   %-34s %9.1f %9.1f %9.1f %9.1f\n", "plain Fast DDS echo (listener)",
+                pct(lat_echo, 50), pct(lat_echo, 90), pct(lat_echo, 99), pct(lat_echo, 100));
+    std::printf("   %-34s %9.1f %9.1f %9.1f\n", "added by the sidecar",
+                pct(lat_svc, 50) - pct(lat_echo, 50), pct(lat_svc, 90) - pct(lat_echo, 90),
+                pct(lat_svc, 99) - pct(lat_echo, 99));
+    std::printf("   ratio sidecar/echo: p50 %.2f, p99 %.2f; target: added p99 <= 200 us: %s\n",
+                pct(lat_svc, 50) / pct(lat_echo, 50), pct(lat_svc, 99) / pct(lat_echo, 99),
+                pct(lat_svc, 99) - pct(lat_echo, 99) <= 200.0 ? "met" : "NOT met");
+    std::fflush(stdout);
+  }
+
+  if (o.cpu) {
+    const std::string part = "bench_cpu_" + tag;
+    std::vector<std::string> svc_args = {USV_FDI_EXE, "run", "--config",
+                                         write_service_config(dir, "cpu", false)};
+    for (const auto& a : common(part)) svc_args.push_back(a);
+    Child svc(svc_args, dir + "/cpu_sidecar.log");
+    std::vector<std::string> echo_args = {self, "echo"};
+    for (const auto& a : common(part)) echo_args.push_back(a);
+    Child echo(echo_args, dir + "/cpu_echo.log");
+    if (!wait_for_text(dir + "/cpu_sidecar.log", "waiting for INS", 15) ||
+        !wait_for_text(dir + "/cpu_echo.log", "echo ready", 15)) {
+      std::fprintf(stderr, "responders did not start; see %s\n", dir.c_str());
+      return 1;
+    }
+    Endpoint ep(o, part);
+    if (!ep.matched(15)) {
+      std::fprintf(stderr, "no match with the responders; see %s\n", dir.c_str());
+      return 1;
+    }
+    Voyage voyage(o.rate);
+    const double warmup = 5.0;
+    const auto t0 = Clock::now();
+    ProcUsage s0{}, e0{};
+    bool started = false;
+    Clock::time_point t_meas;
+    std::uint64_t k = 0;
+    for (;;) {
+      const double t = static_cast<double>(k) / o.rate;
+      std::this_thread::sleep_until(
+          t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t)));
+      if (!started && t >= warmup) {
+        s0 = usage(svc.pid());
+        e0 = usage(echo.pid());
+        t_meas = Clock::now();
+        started = true;
+      }
+      if (t >= warmup + o.cpu_seconds) break;
+      const usvfdi::SimRow r = voyage.next();
+      ep.write(r.t, r.v, r.r, r.delta);
+      ++k;
+    }
+    const double wall = std::chrono::duration<double>(Clock::now() - t_meas).count();
+    const ProcUsage s1 = usage(svc.pid()), e1 = usage(echo.pid());
+    const std::string svc_log = slurp(dir + "/cpu_sidecar.log");
+    std::printf(
+        "\n2. Resources at %.0f Hz INS + rudder input (Otter, autopilot, realistic noise), "
+        "%.0f s after %.0f s warm-up\n",
+        o.rate, wall, warmup);
+    std::printf("   %-34s %9s %9s %9s\n", "process", "CPU [%]", "RSS [MB]", "HWM [MB]");
+    std::printf("   %-34s %9.2f %9.1f %9.1f\n", "usv-fdi run (sidecar)",
+                100.0 * (s1.cpu_s - s0.cpu_s) / wall, s1.rss_mb, s1.hwm_mb);
+    std::printf("   %-34s %9.2f %9.1f %9.1f\n", "plain Fast DDS echo (same stream)",
+                100.0 * (e1.cpu_s - e0.cpu_s) / wall, e1.rss_mb, e1.hwm_mb);
+    std::printf(
+        "   sidecar/echo: CPU %.2f, RSS %.2f; targets < 2 %% of a core: %s, < 40 MB RSS: "
+        "%s\n",
+        (s1.cpu_s - s0.cpu_s) / std::max(1e-9, e1.cpu_s - e0.cpu_s), s1.rss_mb / e1.rss_mb,
+        100.0 * (s1.cpu_s - s0.cpu_s) / wall < 2.0 ? "met" : "NOT met",
+        s1.hwm_mb < 40.0 ? "met" : "NOT met");
+    std::printf("   (%llu samples written; the sidecar raised %zu fault events)\n",
+                static_cast<unsigned long long>(k), count_of(svc_log, "fault event MMSI"));
+  }
+  return 0;
+}
+
+Options parse(int argc, char** argv, bool* echo) {
+  Options o;
+  *echo = argc > 1 && std::string(argv[1]) == "echo";
+  for (int i = *echo ? 2 : 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--faults") {
+      o.faults = std::stoi(value());
+    } else if (a == "--block") {
+      o.block = std::stoi(value());
+    } else if (a == "--cpu-seconds") {
+      o.cpu_seconds = std::stod(value());
+    } else if (a == "--rate") {
+      o.rate = std::stod(value());
+    } else if (a == "--domain") {
+      o.domain = static_cast<std::uint32_t>(std::stoul(value()));
+    } else if (a == "--participant-profile") {
+      o.participant = value();
+    } else if (a == "--partition") {
+      o.partition = value();
+    } else if (a == "--skip-latency") {
+      o.latency = false;
+    } else if (a == "--skip-cpu") {
+      o.cpu = false;
+    } else {
+      throw std::invalid_argument("unknown option " + a);
+    }
+  }
+  if (o.faults < 1 || o.block < 1 || !(o.cpu_seconds > 0) || !(o.rate > 0) || o.domain > 232) {
+    throw std::invalid_argument(
+        "--faults, --block, --cpu-seconds, --rate must be positive, "
+        "--domain 0..232");
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    bool echo = false;
+    const Options o = parse(argc, argv, &echo);
+    if (echo) return run_echo(o);
+    char self[4096];
+    const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0) throw std::runtime_error("readlink /proc/self/exe failed");
+    self[n] = '\0';
+    return run_driver(o, self);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "usv_fdi_bench_dds: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,159 @@
+#include "fleet.hpp"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "io/json_lite.hpp"
+#include "test_env.hpp"
+
+namespace usv_fdi::dds::test {
+namespace {
+
+namespace js = usvfdi::testing_json;
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
+}
+
+}  // namespace
+
+bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,
+                        std::vector<MonitorStatus>* statuses, std::string* error) {
+  if (line.empty() || line[0] != '{') return true;
+  try {
+    const js::Value v = js::Parser(line).parse_document();
+    const std::string type = v.at("type").str;
+    if (type == "fault") {
+      MonitorEvent e;
+      e.mmsi = static_cast<unsigned>(v.at("mmsi").num);
+      e.sensor = v.at("sensor").str;
+      e.state = v.at("state").str;
+      e.kind = v.at("kind").str;
+      e.c_a = v.at("c_a").num;
+      e.c_g = v.at("c_g").num;
+      e.onset_time = v.at("onset_time").num;
+      e.detection_time = v.at("detection_time").num;
+      e.stamp = v.at("stamp").num;
+      e.sequence = static_cast<unsigned long long>(v.at("sequence").num);
+      e.alive = v.at("alive").b;
+      if (events != nullptr) events->push_back(e);
+    } else if (type == "status") {
+      MonitorStatus s;
+      s.mmsi = static_cast<unsigned>(v.at("mmsi").num);
+      s.stamp = v.at("stamp").kind == js::Value::kNumber ? v.at("stamp").num : -1.0;
+      s.converged = v.at("converged").b;
+      s.armed = v.at("armed").b;
+      s.samples = static_cast<unsigned long long>(v.at("samples").num);
+      s.dropped = static_cast<unsigned long long>(v.at("dropped").num);
+      if (statuses != nullptr) statuses->push_back(s);
+    }
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+  return true;
+}
+
+Fleet::Fleet() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string(info->test_suite_name()) + "_" + info->name();
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  dir_ = ::testing::TempDir() + "usv_fdi_" + name + "_" + std::to_string(::getpid()) + "/";
+  fs::create_directories(dir_);
+  domain_ = std::to_string(test_domain_id());
+  partition_ = unique_partition();
+}
+
+Fleet::~Fleet() {
+  procs_.clear();  // ChildProcess: SIGKILL + reap whatever still runs
+  if (!::testing::Test::HasFailure()) {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  } else {
+    std::fprintf(stderr, "logs kept in %s\n", dir_.c_str());
+  }
+}
+
+std::vector<std::string> Fleet::dds_args() const {
+  return {"--domain",
+          domain_,
+          "--partition",
+          partition_,
+          "--participant-profile",
+          "usv_fdi_participant_loopback",
+          "--qos",
+          kProfilesFile};
+}
+
+std::string Fleet::write_service_config(const std::string& name, unsigned mmsi,
+                                        const std::vector<std::string>& extra) const {
+  const std::string path = dir_ + name + ".yaml";
+  std::ofstream f(path);
+  f << slurp(std::string(USV_FDI_SOURCE_DIR) + "/config/scenarios/paper.yaml");
+  f << "\nservice:\n  mmsi: " << mmsi << "\n  reliable_inputs: true\n  status_rate: 5\n";
+  for (const auto& line : extra) f << "  " << line << "\n";
+  if (!f) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+ChildProcess& Fleet::start(const std::string& name, std::vector<std::string> args,
+                           const std::vector<std::string>& extra_env) {
+  std::vector<std::string> argv = {USV_FDI_EXE};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const auto d = dds_args();
+  argv.insert(argv.end(), d.begin(), d.end());
+  auto p = std::make_unique<ChildProcess>(argv, dir_ + name + ".log", extra_env);
+  ChildProcess& ref = *p;
+  procs_[name] = std::move(p);
+  return ref;
+}
+
+std::string Fleet::log(const std::string& name) const { return slurp(dir_ + name + ".log"); }
+
+bool Fleet::wait_for_log(const std::string& name, const std::string& text,
+                         std::chrono::milliseconds timeout) const {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    if (log(name).find(text) != std::string::npos) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+ChildProcess& Fleet::start_service(const std::string& name, const std::string& config,
+                                   int wait_monitors, std::vector<std::string> extra_args) {
+  std::vector<std::string> args = {"run", "--config", config};
+  args.insert(args.end(), extra_args.begin(), extra_args.end());
+  ChildProcess& p = start(name, args);
+  EXPECT_TRUE(wait_for_log(name, "waiting for INS and rudder", std::chrono::seconds(10)))
+      << log(name);
+  if (wait_monitors > 0) {
+    const std::string text = std::to_string(wait_monitors) + " fault-event reader(s)";
+    EXPECT_TRUE(wait_for_log(name, text, std::chrono::seconds(15))) << log(name);
+  }
+  return p;
+}
+
+std::optional<int> Fleet::run_to_end(const std::string& name, std::vector<std::string> args,
+                                     std::chrono::milliseconds timeout, std::string* out) {
+  ChildProcess& p = start(name, std::move(args));
+  const std::string text = p.read_all(timeout);
+  if (out != nullptr) *out = text;
+  return p.wait_exit(std::chrono::milliseconds(2000));
+}
+
+}  // namespace usv_fdi::dds::test

@@ -1,0 +1,94 @@
+// Helpers for the end-to-end tests of the usv-fdi executable over real Fast DDS: every
+// process (sidecar, simulator publisher, monitor) is the real `usv-fdi` binary in its own
+// process, on UDPv4 bound to 127.0.0.1, in a domain and partition private to the test.
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "process.hpp"
+
+namespace usv_fdi::dds::test {
+
+/// One FaultEvent update as printed by `usv-fdi monitor --json`.
+struct MonitorEvent {
+  unsigned mmsi = 0;
+  std::string sensor, state, kind;
+  double c_a = 0, c_g = 0, onset_time = 0, detection_time = 0, stamp = 0;
+  unsigned long long sequence = 0;
+  bool alive = true;
+};
+
+/// One FdiStatus as printed by `usv-fdi monitor --json --status`.
+struct MonitorStatus {
+  unsigned mmsi = 0;
+  double stamp = 0;
+  bool converged = false, armed = false;
+  unsigned long long samples = 0, dropped = 0;
+};
+
+/// Parses monitor --json lines (others are ignored); returns false on a malformed JSON line.
+bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,
+                        std::vector<MonitorStatus>* statuses, std::string* error);
+
+class Fleet {
+ public:
+  /// Creates a private directory for configs and logs, a domain id and a partition.
+  Fleet();
+  /// Kills (SIGKILL) whatever is still running; removes the directory unless the test failed.
+  ~Fleet();
+
+  const std::string& dir() const { return dir_; }
+  /// --domain, --partition, --participant-profile (loopback), --qos (shipped profiles).
+  std::vector<std::string> dds_args() const;
+
+  /// Writes the paper scenario's engine config (config/scenarios/paper.yaml) with a service
+  /// section: mmsi, reliable_inputs, status_rate 5, and `extra` lines (indented 2 spaces).
+  std::string write_service_config(const std::string& name, unsigned mmsi,
+                                   const std::vector<std::string>& extra = {}) const;
+
+  /// Starts `usv-fdi <args> <dds_args>` with stderr to <dir>/<name>.log.
+  ChildProcess& start(const std::string& name, std::vector<std::string> args,
+                      const std::vector<std::string>& extra_env = {});
+  ChildProcess& process(const std::string& name) { return *procs_.at(name); }
+  std::string log(const std::string& name) const;
+  /// Waits until <name>.log contains `text`.
+  bool wait_for_log(const std::string& name, const std::string& text,
+                    std::chrono::milliseconds timeout) const;
+
+  /// Starts the sidecar for `mmsi` and waits until it runs; with `wait_monitors`, also until
+  /// that many fault-event readers are matched.
+  ChildProcess& start_service(const std::string& name, const std::string& config,
+                              int wait_monitors = 0, std::vector<std::string> extra_args = {});
+  /// Runs a process to its end (bounded); returns its exit code (nullopt: still running).
+  std::optional<int> run_to_end(const std::string& name, std::vector<std::string> args,
+                                std::chrono::milliseconds timeout, std::string* out = nullptr);
+
+ private:
+  std::string dir_;
+  std::string domain_, partition_;
+  std::map<std::string, std::unique_ptr<ChildProcess>> procs_;
+};
+
+/// Reads monitor lines until `done(events)` holds or the timeout elapses.
+template <class Done>
+bool read_monitor_until(ChildProcess& monitor, std::vector<MonitorEvent>* events,
+                        std::vector<MonitorStatus>* statuses, std::chrono::milliseconds timeout,
+                        Done done, std::string* error) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done(*events)) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    const auto line = monitor.read_line(left);
+    if (!line) return false;
+    if (!parse_monitor_line(*line, events, statuses, error)) return false;
+  }
+  return true;
+}
+
+}  // namespace usv_fdi::dds::test

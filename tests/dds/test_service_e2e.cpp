@@ -1,0 +1,498 @@
+// End-to-end tests of the DDS microservice: the real `usv-fdi` executable as sidecar
+// (`run`), simulator publisher (`sim --publish`) and shore monitor (`monitor`), each in its
+// own process, over real Fast DDS on UDPv4 bound to 127.0.0.1 (unicast discovery), in a
+// domain and partition private to the test (ctest -j safe). The simulator publishes the
+// paper's scenario (Otter, noise-free, gyro bias on 20-40 s, accelerometer bias on 60-80 s)
+// 20-25 times faster than real time, so a 100 s voyage takes ~5 s.
+//
+// Numbers are asserted as behaviour with tolerances (raised within 3 s of onset, isolated
+// with C_i >= 0.8 against <= 0.2, cleared within 5 s of the fault's end), not bit-exactly:
+// the numerics of the core may change.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fleet.hpp"
+#include "test_env.hpp"
+
+namespace usv_fdi::dds::test {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using Clock = std::chrono::steady_clock;
+
+std::vector<MonitorEvent> of(const std::vector<MonitorEvent>& all, unsigned mmsi,
+                             const std::string& sensor) {
+  std::vector<MonitorEvent> out;
+  for (const auto& e : all) {
+    if (e.mmsi == mmsi && e.sensor == sensor && e.alive) out.push_back(e);
+  }
+  return out;
+}
+
+bool has(const std::vector<MonitorEvent>& all, unsigned mmsi, const std::string& sensor,
+         const std::string& state, double t_min = -1e9) {
+  return std::any_of(all.begin(), all.end(), [&](const MonitorEvent& e) {
+    return e.mmsi == mmsi && e.sensor == sensor && e.state == state && e.stamp >= t_min;
+  });
+}
+
+std::string dump(const std::vector<MonitorEvent>& all) {
+  std::string s;
+  for (const auto& e : all) {
+    s += std::to_string(e.mmsi) + " " + e.sensor + " #" + std::to_string(e.sequence) + " " +
+         e.state + " " + e.kind + " t=" + std::to_string(e.stamp) +
+         " C_a=" + std::to_string(e.c_a) + " C_g=" + std::to_string(e.c_g) +
+         (e.alive ? "" : " (writer gone)") + "\n";
+  }
+  return s;
+}
+
+/// The residual fault of `sensor` on (t0, t1): raised within 3 s of t0, isolated to it,
+/// cleared within 5 s of t1; sequence numbers increase.
+void expect_fault_episode(const std::vector<MonitorEvent>& evs, const std::string& sensor,
+                          double t0, double t1, const std::string& context) {
+  SCOPED_TRACE(context);
+  std::vector<MonitorEvent> in;  // events of the episode (stamp before the end of data)
+  for (const auto& e : evs) {
+    if (e.stamp < 100.0) in.push_back(e);
+  }
+  ASSERT_GE(in.size(), 2u) << "expected raised and cleared";
+  const MonitorEvent& raised = in.front();
+  EXPECT_EQ(raised.state, "raised");
+  EXPECT_GE(raised.stamp, t0);
+  EXPECT_LE(raised.stamp, t0 + 3.0);
+  EXPECT_NEAR(raised.onset_time, t0, 1.0);
+  const double c_own = sensor == "gyro" ? raised.c_g : raised.c_a;
+  const double c_other = sensor == "gyro" ? raised.c_a : raised.c_g;
+  EXPECT_GE(c_own, 0.8) << "not isolated to " << sensor;
+  EXPECT_LE(c_other, 0.2);
+  const MonitorEvent& cleared = in.back();
+  EXPECT_EQ(cleared.state, "cleared");
+  EXPECT_GE(cleared.stamp, t1);
+  EXPECT_LE(cleared.stamp, t1 + 5.0);
+  // The latched event keeps the raise's isolation and times while it is cleared.
+  EXPECT_EQ(cleared.detection_time, raised.detection_time);
+  EXPECT_EQ(cleared.c_g, raised.c_g);
+  for (std::size_t i = 1; i < in.size(); ++i) {
+    EXPECT_GT(in[i].sequence, in[i - 1].sequence);
+    if (i + 1 < in.size()) {
+      EXPECT_EQ(in[i].state, "raised") << "only kind refinements between";
+    }
+  }
+}
+
+/// The integer right before `suffix` in `text` (e.g. "(5001 samples" with suffix " samples"),
+/// or -1. (No std::regex: GCC 12 warns inside it under -fsanitize=address -Werror.)
+long long number_before(const std::string& text, const std::string& suffix) {
+  const auto at = text.find(suffix);
+  if (at == std::string::npos) return -1;
+  auto begin = at;
+  while (begin > 0 && std::isdigit(static_cast<unsigned char>(text[begin - 1]))) --begin;
+  if (begin == at) return -1;
+  return std::stoll(text.substr(begin, at - begin));
+}
+
+std::vector<std::string> sim_args(const std::vector<std::string>& extra) {
+  std::vector<std::string> a = {"sim",   "--publish",     "--vessel", "otter",      "--scenario",
+                                "paper", "--noise-scale", "0",        "--reliable", "--linger",
+                                "0.2"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+// ------------------------------------------------------------------ paper scenario
+
+TEST(ServiceEndToEnd, PaperScenarioRaisesIsolatesAndClearsBothFaults) {
+  // GIVEN a monitor and a sidecar for one vessel (default input timeout 1 s)
+  Fleet f;
+  const unsigned m = 257100001;
+  const std::string cfg = f.write_service_config("svc", m);
+  ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
+  f.start_service("svc", cfg, 1);
+  // WHEN the simulator publishes the paper's scenario 20x faster than real time, then stops
+  const auto t_start = Clock::now();
+  ChildProcess& sim = f.start("sim", sim_args({"--mmsi", std::to_string(m), "--speed", "20"}));
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  const bool complete = read_monitor_until(
+      monitor, &ev, &st, seconds(45),
+      [&](const std::vector<MonitorEvent>& e) {
+        return has(e, m, "gyro", "raised", 100.0) && has(e, m, "accelerometer", "raised", 100.0);
+      },
+      &err);
+  ASSERT_TRUE(complete) << err << "\n" << dump(ev) << f.log("svc") << f.log("sim");
+  const auto sim_exit = sim.wait_exit(seconds(10));
+  ASSERT_TRUE(sim_exit.has_value());
+  EXPECT_EQ(*sim_exit, 0) << f.log("sim");
+  std::printf("paper scenario over DDS: %.1f s wall\n",
+              std::chrono::duration<double>(Clock::now() - t_start).count());
+
+  // THEN each fault was raised, isolated with its C_i, and cleared; nothing else was raised
+  expect_fault_episode(of(ev, m, "gyro"), "gyro", 20.0, 40.0, dump(ev));
+  expect_fault_episode(of(ev, m, "accelerometer"), "accelerometer", 60.0, 80.0, dump(ev));
+  for (const auto& e : ev) {
+    EXPECT_EQ(e.mmsi, m);
+    EXPECT_NE(e.sensor, "unknown") << dump(ev);
+  }
+  // AND when the INS stopped publishing, both channels were reported stale (timeout)
+  for (const char* s : {"gyro", "accelerometer"}) {
+    const auto last = of(ev, m, s).back();
+    EXPECT_EQ(last.state, "raised") << s;
+    EXPECT_EQ(last.kind, "stale") << s;
+    EXPECT_GT(last.stamp, 100.0) << s;
+  }
+  // AND the status topic reported a converged, armed detector that saw every sample
+  ASSERT_FALSE(st.empty());
+  EXPECT_TRUE(st.back().converged);
+  EXPECT_TRUE(st.back().armed);
+  EXPECT_EQ(st.back().mmsi, m);
+  unsigned long long most = 0;
+  for (const auto& s : st) most = std::max(most, s.samples);
+  // 100 s at 50 Hz (+1 stale marker), RELIABLE: nothing lost but perhaps the very first sample
+  EXPECT_GE(most, 5000u);
+  EXPECT_EQ(st.back().dropped, 0u);
+
+  // AND the sidecar exits 0 within 2 s of SIGTERM; the monitor sees it go
+  ChildProcess& svc = f.process("svc");
+  const auto t_sig = Clock::now();
+  svc.signal(SIGTERM);
+  const auto code = svc.wait_exit(milliseconds(2000));
+  ASSERT_TRUE(code.has_value()) << "sidecar still running 2 s after SIGTERM";
+  EXPECT_EQ(*code, 0) << f.log("svc");
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - t_sig).count(), 2.0);
+  EXPECT_NE(f.log("svc").find("stopped in"), std::string::npos) << f.log("svc");
+  std::vector<MonitorEvent> after;
+  EXPECT_TRUE(read_monitor_until(
+      monitor, &after, nullptr, seconds(10),
+      [&](const std::vector<MonitorEvent>& e) {
+        return std::count_if(e.begin(), e.end(), [](const auto& x) { return !x.alive; }) >= 2;
+      },
+      &err))
+      << "the monitor did not flag both instances as 'sidecar gone'\n"
+      << dump(after);
+  monitor.signal(SIGTERM);
+  const auto mcode = monitor.wait_exit(milliseconds(2000));
+  ASSERT_TRUE(mcode.has_value());
+  EXPECT_EQ(*mcode, 0) << f.log("monitor");
+}
+
+// ------------------------------------------------------------------ late joiner
+
+/// Runs a sidecar and the first 70 s of the paper scenario with no monitor at all: the gyro
+/// fault is raised and cleared (cleared-unacknowledged, #2), the accelerometer fault raised
+/// (#1) when the data ends. input_timeout 60 s: no stale fault while the test looks.
+void run_partial_voyage(Fleet& f, unsigned m, const std::vector<std::string>& extra_service = {}) {
+  std::vector<std::string> extra = {"input_timeout: 60"};
+  extra.insert(extra.end(), extra_service.begin(), extra_service.end());
+  const std::string cfg = f.write_service_config("svc", m, extra);
+  f.start_service("svc", cfg);
+  const auto code = f.run_to_end(
+      "sim", sim_args({"--mmsi", std::to_string(m), "--speed", "25", "--duration", "70"}),
+      seconds(40));
+  ASSERT_TRUE(code.has_value()) << "sim did not finish";
+  ASSERT_EQ(*code, 0) << f.log("sim");
+  ASSERT_TRUE(f.wait_for_log("svc", "accelerometer #1 raised", seconds(5))) << f.log("svc");
+}
+
+TEST(ServiceEndToEnd, LateJoiningMonitorReceivesTheLatchedStateOfEveryInstance) {
+  Fleet f;
+  const unsigned m = 257100002;
+  // GIVEN faults raised and cleared before any monitor existed
+  run_partial_voyage(f, m);
+  // WHEN a monitor joins afterwards
+  std::string out;
+  const auto code =
+      f.run_to_end("late", {"monitor", "--json", "--once", "--expect", "2", "--duration", "15"},
+                   seconds(25), &out);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << f.log("late");
+  std::vector<MonitorEvent> ev;
+  std::string err;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);) {
+    ASSERT_TRUE(parse_monitor_line(line, &ev, nullptr, &err)) << err;
+  }
+  // THEN it receives the current state of both instances, one sample each (KEEP_LAST 1)
+  ASSERT_EQ(ev.size(), 2u) << out;
+  const auto gyro = of(ev, m, "gyro");
+  const auto acc = of(ev, m, "accelerometer");
+  ASSERT_EQ(gyro.size(), 1u) << out;
+  ASSERT_EQ(acc.size(), 1u) << out;
+  EXPECT_EQ(gyro[0].state, "cleared");  // rectified, not acknowledged: still latched
+  EXPECT_EQ(gyro[0].sequence, 2u);
+  EXPECT_GE(gyro[0].c_g, 0.8);
+  EXPECT_NEAR(gyro[0].detection_time, 20.5, 2.5);
+  EXPECT_GE(gyro[0].stamp, 40.0);
+  EXPECT_EQ(acc[0].state, "raised");
+  EXPECT_EQ(acc[0].sequence, 1u);
+  EXPECT_GE(acc[0].c_a, 0.8);
+  EXPECT_NEAR(acc[0].detection_time, 60.5, 2.5);
+
+  // AND a monitor filtering on another vessel sees nothing
+  std::string other;
+  const auto code2 = f.run_to_end(
+      "other", {"monitor", "--json", "--once", "--duration", "2", "--mmsi", std::to_string(m + 1)},
+      seconds(15), &other);
+  ASSERT_TRUE(code2.has_value());
+  EXPECT_EQ(*code2, 0);
+  EXPECT_EQ(other, "");
+}
+
+// ------------------------------------------------------------------ acknowledgements
+
+TEST(ServiceEndToEnd, AckLifecycleAcceptedStaleUnknownAndUnauthorised) {
+  Fleet f;
+  const unsigned m = 257100003;
+  const std::string ms = std::to_string(m);
+  // GIVEN gyro #2 cleared-unacknowledged and accelerometer #1 raised; only 'alice' may ack
+  run_partial_voyage(f, m, {"authorised_operators: [alice]"});
+  auto ack = [&](const std::string& name, std::vector<std::string> specs, const std::string& who) {
+    std::vector<std::string> args = {"monitor", "--operator", who, "--ack-timeout", "1.5"};
+    for (const auto& s : specs) {
+      args.push_back("--ack");
+      args.push_back(s);
+    }
+    return f.run_to_end(name, args, seconds(30));
+  };
+  auto latched = [&](const std::string& name) {
+    std::string out;
+    const auto code =
+        f.run_to_end(name, {"monitor", "--json", "--once", "--expect", "2", "--duration", "10"},
+                     seconds(20), &out);
+    EXPECT_TRUE(code.has_value() && *code == 0) << f.log(name);
+    std::vector<MonitorEvent> ev;
+    std::string err;
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);) parse_monitor_line(line, &ev, nullptr, &err);
+    return ev;
+  };
+
+  // WHEN stale, unknown, never-published and unauthorised acks are sent
+  const auto refused = ack("refused", {ms + ":gyro:1", ms + ":gyro:9", ms + ":unknown:1"}, "alice");
+  const auto intruder = ack("intruder", {ms + ":accelerometer:1"}, "mallory");
+  // THEN each is refused with its reason in the sidecar's log and nothing changes
+  ASSERT_TRUE(refused.has_value());
+  EXPECT_EQ(*refused, 1) << f.log("refused");
+  ASSERT_TRUE(intruder.has_value());
+  EXPECT_EQ(*intruder, 1) << f.log("intruder");
+  const std::string svc_log = f.log("svc");
+  EXPECT_NE(svc_log.find("ack of gyro #1 by alice refused: stale sequence"), std::string::npos)
+      << svc_log;
+  EXPECT_NE(svc_log.find("ack of gyro #9 by alice refused: unknown sequence"), std::string::npos)
+      << svc_log;
+  EXPECT_NE(svc_log.find("ack of unknown #1 by alice refused: unknown sequence"), std::string::npos)
+      << svc_log;
+  EXPECT_NE(svc_log.find("operator 'mallory' is not authorised"), std::string::npos) << svc_log;
+  const std::string mon_log = f.log("refused");
+  EXPECT_NE(mon_log.find("gyro #1 not accepted"), std::string::npos) << mon_log;
+  EXPECT_NE(mon_log.find("stale sequence (current #2"), std::string::npos) << mon_log;
+  EXPECT_NE(mon_log.find("unknown sequence (current #2"), std::string::npos) << mon_log;
+  auto ev = latched("after_refused");
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(of(ev, m, "gyro").at(0).sequence, 2u);
+  EXPECT_EQ(of(ev, m, "gyro").at(0).state, "cleared");
+  EXPECT_EQ(of(ev, m, "accelerometer").at(0).sequence, 1u);
+  EXPECT_EQ(of(ev, m, "accelerometer").at(0).state, "raised");
+
+  // WHEN the current sequences are acknowledged by an authorised operator
+  const auto accepted = ack("accepted", {ms + ":gyro:2", ms + ":accelerometer:1"}, "alice");
+  // THEN the cleared event becomes acknowledged and the active one active-acknowledged
+  ASSERT_TRUE(accepted.has_value());
+  EXPECT_EQ(*accepted, 0) << f.log("accepted") << f.log("svc");
+  ev = latched("after_accepted");
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(of(ev, m, "gyro").at(0).state, "acknowledged");
+  EXPECT_EQ(of(ev, m, "gyro").at(0).sequence, 3u);
+  EXPECT_EQ(of(ev, m, "accelerometer").at(0).state, "active_acknowledged");
+  EXPECT_EQ(of(ev, m, "accelerometer").at(0).sequence, 2u);
+  // The isolation of the raise survives the acknowledgement.
+  EXPECT_GE(of(ev, m, "accelerometer").at(0).c_a, 0.8);
+
+  // AND acknowledging an acknowledged event again is refused: nothing to acknowledge
+  const auto again = ack("again", {ms + ":gyro:3"}, "alice");
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(*again, 1);
+  EXPECT_TRUE(f.wait_for_log("svc", "refused: nothing to acknowledge", seconds(2))) << f.log("svc");
+}
+
+// ------------------------------------------------------------------ two vessels
+
+TEST(ServiceEndToEnd, TwoVesselsTwoSidecarsOneMonitorNoCrosstalk) {
+  Fleet f;
+  const unsigned m1 = 257100004, m2 = 257100005;
+  // GIVEN one sidecar per vessel and a fleet monitor plus one filtered on vessel 2
+  ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
+  ChildProcess& only2 = f.start("only2", {"monitor", "--json", "--mmsi", std::to_string(m2)});
+  f.start_service("svc1", f.write_service_config("svc1", m1, {"input_timeout: 60"}), 2);
+  f.start_service("svc2", f.write_service_config("svc2", m2, {"input_timeout: 60"}), 2);
+  // WHEN one publisher sends both vessels on the same topics: vessel 1 the paper's faults,
+  // vessel 2 only an accelerometer bias on (30, 50) s
+  ChildProcess& sim =
+      f.start("sim", sim_args({"--mmsi", std::to_string(m1), "--mmsi", std::to_string(m2),
+                               "--healthy", std::to_string(m2), "--fault",
+                               std::to_string(m2) + "@accelerometer:bias:30:50:0.05", "--speed",
+                               "20", "--min-readers", "2"}));
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  const bool complete = read_monitor_until(
+      monitor, &ev, &st, seconds(45),
+      [&](const std::vector<MonitorEvent>& e) {
+        return has(e, m1, "accelerometer", "cleared") && has(e, m2, "accelerometer", "cleared");
+      },
+      &err);
+  ASSERT_TRUE(complete) << err << "\n" << dump(ev) << f.log("svc1") << f.log("svc2");
+  const auto sim_exit = sim.wait_exit(seconds(10));
+  ASSERT_TRUE(sim_exit.has_value());
+  EXPECT_EQ(*sim_exit, 0) << f.log("sim");
+  // Let the last status (every 0.2 s) report the complete voyage.
+  std::this_thread::sleep_for(milliseconds(600));
+  read_monitor_until(
+      monitor, &ev, &st, milliseconds(500), [](const auto&) { return false; }, &err);
+
+  // THEN the fleet monitor sees each vessel's own faults, and nothing else
+  expect_fault_episode(of(ev, m1, "gyro"), "gyro", 20.0, 40.0, dump(ev));
+  expect_fault_episode(of(ev, m1, "accelerometer"), "accelerometer", 60.0, 80.0, dump(ev));
+  expect_fault_episode(of(ev, m2, "accelerometer"), "accelerometer", 30.0, 50.0, dump(ev));
+  EXPECT_TRUE(of(ev, m2, "gyro").empty()) << dump(ev);
+  for (const auto& e : ev) {
+    EXPECT_TRUE(e.mmsi == m1 || e.mmsi == m2) << dump(ev);
+    EXPECT_NE(e.sensor, "unknown") << dump(ev);
+  }
+  // AND each sidecar processed its own vessel's 5001 samples (RELIABLE: nothing lost; the
+  // very first one may precede the sidecar's side of the match), never the other's
+  for (unsigned m : {m1, m2}) {
+    unsigned long long most = 0;
+    for (const auto& s : st) {
+      if (s.mmsi == m) most = std::max(most, s.samples);
+    }
+    EXPECT_GE(most, 5000u) << "vessel " << m;
+    EXPECT_LE(most, 5001u) << "vessel " << m;
+  }
+  // AND the filtered monitor saw vessel 2 only
+  std::vector<MonitorEvent> ev2;
+  read_monitor_until(
+      only2, &ev2, nullptr, milliseconds(500), [](const auto&) { return false; }, &err);
+  ASSERT_FALSE(ev2.empty());
+  for (const auto& e : ev2) EXPECT_EQ(e.mmsi, m2) << dump(ev2);
+
+  // AND both sidecars stop cleanly, having skipped the other vessel's samples
+  for (const char* name : {"svc1", "svc2"}) {
+    ChildProcess& svc = f.process(name);
+    svc.signal(SIGTERM);
+    const auto code = svc.wait_exit(milliseconds(2000));
+    ASSERT_TRUE(code.has_value()) << name;
+    EXPECT_EQ(*code, 0) << f.log(name);
+    const std::string log = f.log(name);
+    const auto stopped = log.substr(std::min(log.size(), log.find("stopped in")));
+    const long long own = number_before(stopped, " samples, ");
+    EXPECT_GE(own, 5000) << log;
+    EXPECT_LE(own, 5001) << log;
+    // the other vessel's INS and rudder samples
+    const long long other = number_before(stopped, " samples of other vessels skipped");
+    EXPECT_GE(other, 10000) << log;
+    EXPECT_LE(other, 10002) << log;
+  }
+}
+
+// ------------------------------------------------------------------ shutdown under load
+
+class ShutdownUnderLoad : public ::testing::TestWithParam<int> {};
+
+TEST_P(ShutdownUnderLoad, SidecarExitsZeroWithinTwoSeconds) {
+  Fleet f;
+  const unsigned m = 257100006;
+  const int sig = GetParam();
+  // GIVEN a sidecar flooded with samples (as fast as the publisher can write, realistic noise)
+  // and a monitor
+  f.start("monitor", {"monitor", "--json"});
+  ChildProcess& svc = f.start_service(
+      "svc", f.write_service_config("svc", m, {"input_timeout: 60", "input_queue: 256"}), 1);
+  ChildProcess& sim =
+      f.start("sim", {"sim", "--publish", "--vessel", "otter", "--scenario", "paper", "--speed",
+                      "10000", "--duration", "100000", "--reliable", "--mmsi", std::to_string(m)});
+  ASSERT_TRUE(f.wait_for_log("svc", "1 INS writer(s)", seconds(15))) << f.log("svc");
+  std::this_thread::sleep_for(milliseconds(1500));
+  ASSERT_TRUE(sim.running()) << f.log("sim");
+  // WHEN it receives the signal
+  const auto t0 = Clock::now();
+  svc.signal(sig);
+  const auto code = svc.wait_exit(milliseconds(2000));
+  const double took = std::chrono::duration<double>(Clock::now() - t0).count();
+  // THEN it exits 0 within 2 s, after joining its threads and deleting its DDS entities
+  ASSERT_TRUE(code.has_value()) << "still running 2 s after signal " << sig << "\n" << f.log("svc");
+  EXPECT_EQ(*code, 0) << f.log("svc");
+  EXPECT_LT(took, 2.0);
+  const std::string log = f.log("svc");
+  EXPECT_NE(log.find("signal " + std::to_string(sig) + ": stopping"), std::string::npos) << log;
+  const auto stopped = log.substr(std::min(log.size(), log.find("stopped in")));
+  const long long samples = number_before(stopped, " samples, ");
+  EXPECT_GT(samples, 1000) << "it was not under load\n" << log;
+  std::printf("sidecar stopped %.3f s after signal %d, %lld samples processed\n", took, sig,
+              samples);
+  // AND the publisher stops on SIGINT as well
+  sim.signal(SIGINT);
+  const auto sim_code = sim.wait_exit(milliseconds(2000));
+  ASSERT_TRUE(sim_code.has_value());
+  EXPECT_EQ(*sim_code, 0) << f.log("sim");
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, ShutdownUnderLoad, ::testing::Values(SIGTERM, SIGINT),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           return std::string(info.param == SIGTERM ? "sigterm" : "sigint");
+                         });
+
+// ------------------------------------------------------------------ bad input
+
+TEST(ServiceCli, BadConfigurationsAreRefusedWithTheirReason) {
+  Fleet f;
+  struct Case {
+    std::string yaml_service;  ///< service section lines
+    std::string expect;        ///< in stderr
+  };
+  const std::vector<Case> cases = {
+      {"mmsi: abc", "service.mmsi = abc: must be an MMSI"},
+      {"mmsi: 1\n  domain_id: 999", "service.domain_id = 999: must be 0..232"},
+      {"mmsi: 1\n  colour: red", "service.colour = colour: unknown key"},
+      {"mmsi: 1\n  status_rate: -1", "service.status_rate = -1: must be a positive rate"},
+      {"mmsi: 1\n  qos_profiles: nowhere.xml", "no such file"},
+      {"reliable_inputs: true", "service.mmsi is not set"},
+  };
+  int i = 0;
+  for (const Case& c : cases) {
+    const std::string name = "bad" + std::to_string(i++);
+    const std::string path = f.dir() + name + ".yaml";
+    {
+      std::ofstream y(path);
+      y << "model:\n  B: [0.165394, -2.19400]\nservice:\n  " << c.yaml_service << "\n";
+    }
+    const auto code = f.run_to_end(name, {"run", "--config", path}, seconds(10));
+    ASSERT_TRUE(code.has_value());
+    EXPECT_EQ(*code, 2) << c.yaml_service << "\n" << f.log(name);
+    EXPECT_NE(f.log(name).find(c.expect), std::string::npos) << f.log(name);
+    EXPECT_NE(f.log(name).find(path), std::string::npos) << "names the file\n" << f.log(name);
+  }
+  // Command-line mistakes: exit 64 with the reason.
+  const auto sim = f.run_to_end("sim", {"sim", "--publish"}, seconds(10));
+  ASSERT_TRUE(sim.has_value());
+  EXPECT_EQ(*sim, 64) << f.log("sim");
+  EXPECT_NE(f.log("sim").find("--mmsi"), std::string::npos) << f.log("sim");
+  const auto ack = f.run_to_end("ack", {"monitor", "--ack", "1:gyro"}, seconds(10));
+  ASSERT_TRUE(ack.has_value());
+  EXPECT_EQ(*ack, 64) << f.log("ack");
+  EXPECT_NE(f.log("ack").find("expected MMSI:SENSOR:SEQUENCE"), std::string::npos) << f.log("ack");
+}
+
+}  // namespace
+}  // namespace usv_fdi::dds::test

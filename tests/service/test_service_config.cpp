@@ -1,0 +1,124 @@
+// The sidecar's YAML (engine keys + `service:` section): the shipped example loads with the
+// documented values; every mistake is an error naming file, line, key and value.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include "usv_fdi/dds_service/service.hpp"
+#include "usv_fdi/io/config.hpp"
+
+namespace usvfdi::service {
+namespace {
+
+const std::string kSource = USV_FDI_SOURCE_DIR;
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const std::string path =
+      ::testing::TempDir() + "usv_fdi_svc_" + std::to_string(::getpid()) + "_" + name + ".yaml";
+  std::ofstream f(path);
+  f << text;
+  return path;
+}
+
+TEST(ServiceConfig, ShippedExampleLoadsWithItsDocumentedValues) {
+  const ServiceConfig c = load_service_config(kSource + "/config/service/example.yaml");
+  EXPECT_EQ(c.mmsi, 257000001u);
+  EXPECT_EQ(c.dds.domain_id, 0u);
+  EXPECT_EQ(c.dds.participant_profile, "usv_fdi_participant");
+  EXPECT_EQ(c.dds.topics.fault_event, "usv_fdi/fault_event");
+  EXPECT_TRUE(c.dds.publisher_partitions.empty());
+  EXPECT_FALSE(c.reliable_inputs);
+  EXPECT_DOUBLE_EQ(c.pipeline.status_period, 1.0);
+  EXPECT_EQ(c.pipeline.input_capacity, 4096u);
+  EXPECT_EQ(c.log_level, "info");
+  // qos_profiles is relative to the config file.
+  EXPECT_EQ(c.dds.profiles_file, kSource + "/config/qos/usv_fdi_profiles.xml");
+  EXPECT_DOUBLE_EQ(c.engine.B(0), 0.165394);
+}
+
+TEST(ServiceConfig, EveryServiceKeyIsApplied) {
+  const std::string path = write_temp("all", R"(model:
+  B: [0.1, -2.0]
+service:
+  mmsi: 123456789
+  domain_id: 42
+  participant_profile: usv_fdi_participant_shm
+  topics: {ins: a/ins, rudder: a/rudder, fault_event: a/ev, fault_ack: a/ack, status: a/st}
+  partitions: [fleet_a, fleet_b]
+  reliable_inputs: true
+  status_rate: 4
+  log_level: debug
+  authorised_operators: [alice, bob]
+  input_queue: 100
+  rudder_wait: 0.2
+  rudder_timeout: 0.7
+  input_timeout: 3
+)");
+  const ServiceConfig c = load_service_config(path);
+  EXPECT_EQ(c.mmsi, 123456789u);
+  EXPECT_EQ(c.dds.domain_id, 42u);
+  EXPECT_EQ(c.dds.participant_profile, "usv_fdi_participant_shm");
+  EXPECT_EQ(c.dds.topics.ins, "a/ins");
+  EXPECT_EQ(c.dds.topics.rudder, "a/rudder");
+  EXPECT_EQ(c.dds.topics.fault_event, "a/ev");
+  EXPECT_EQ(c.dds.topics.fault_ack, "a/ack");
+  EXPECT_EQ(c.dds.topics.status, "a/st");
+  EXPECT_EQ(c.dds.publisher_partitions, (std::vector<std::string>{"fleet_a", "fleet_b"}));
+  EXPECT_EQ(c.dds.subscriber_partitions, c.dds.publisher_partitions);
+  EXPECT_TRUE(c.reliable_inputs);
+  EXPECT_DOUBLE_EQ(c.pipeline.status_period, 0.25);
+  EXPECT_EQ(c.log_level, "debug");
+  EXPECT_EQ(c.pipeline.authorised_operators, (std::vector<std::string>{"alice", "bob"}));
+  EXPECT_EQ(c.pipeline.input_capacity, 100u);
+  EXPECT_DOUBLE_EQ(c.pipeline.rudder_wait, 0.2);
+  EXPECT_DOUBLE_EQ(c.pipeline.rudder_timeout, 0.7);
+  EXPECT_DOUBLE_EQ(c.pipeline.input_timeout, 3.0);
+  std::remove(path.c_str());
+}
+
+TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
+  struct Case {
+    std::string service;  // lines of the service section
+    std::string expect;   // in the message, after "<file>:"
+  };
+  const Case cases[] = {
+      {"  mmsi: 0", "4: service.mmsi = 0: must be an MMSI"},
+      {"  mmsi: 1000000000", "4: service.mmsi = 1000000000: must be an MMSI"},
+      {"  domain_id: 233", "4: service.domain_id = 233: must be 0..232"},
+      {"  domain_id: x", "4: service.domain_id = x: must be an integer"},
+      {"  status_rate: 0", "4: service.status_rate = 0: must be a positive rate"},
+      {"  log_level: loud", "4: service.log_level = loud: must be one of"},
+      {"  partitions: fleet", "4: service.partitions = fleet: must be a list"},
+      {"  topics: {ins: a, radar: b}", "4: service.topics.radar = b: unknown topic"},
+      {"  input_queue: 0", "4: service.input_queue = 0: must be 1..1000000"},
+      {"  rudder_wait: -1", "4: service.rudder_wait = -1: must be a positive time"},
+      {"  reliable_inputs: maybe", "4: service.reliable_inputs = maybe: must be true or false"},
+      {"  qos_profiles: missing.xml", "4: service.qos_profiles = missing.xml: no such file"},
+      {"  mmsi: 1\n  colour: red", "5: service.colour = colour: unknown key"},
+  };
+  for (const Case& c : cases) {
+    const std::string path =
+        write_temp("bad", "model:\n  B: [0.1, -2.0]\nservice:\n" + c.service + "\n");
+    try {
+      load_service_config(path);
+      ADD_FAILURE() << "accepted: " << c.service;
+    } catch (const io::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ":" + c.expect), std::string::npos)
+          << e.what() << "\n  expected: " << c.expect;
+    }
+    std::remove(path.c_str());
+  }
+  // The section must be a mapping; engine mistakes are reported by the engine loader.
+  const std::string p1 = write_temp("list", "model:\n  B: [0.1, -2.0]\nservice: [1, 2]\n");
+  EXPECT_THROW(load_service_config(p1), io::ConfigError);
+  const std::string p2 = write_temp("engine", "model:\n  B: [0.1]\nservice:\n  mmsi: 1\n");
+  EXPECT_THROW(load_service_config(p2), io::ConfigError);
+  std::remove(p1.c_str());
+  std::remove(p2.c_str());
+}
+
+}  // namespace
+}  // namespace usvfdi::service
