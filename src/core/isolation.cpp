@@ -68,6 +68,7 @@ void IsolationParams::validate() const {
           "exit_ratio * threshold must exceed 1 (healthy J_N is about 1)");
   require(enter_time >= 0, "enter_time", enter_time, "must be >= 0");
   require(leave_time >= 0, "leave_time", leave_time, "must be >= 0");
+  require(second_fault_time >= 0, "second_fault_time", second_fault_time, "must be >= 0");
   require(min_active_time >= 0, "min_active_time", min_active_time, "must be >= 0");
   require(c_min > 0 && c_min <= 1, "c_min", c_min, "must lie in (0, 1]");
   require(c_margin >= 0 && c_margin < 1, "c_margin", c_margin, "must lie in [0, 1)");
@@ -215,6 +216,7 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
   if (before == 0 && c.sources != 0) {
     c.active = true;
     c.kind = kind;
+    if (sensor != Sensor::kUnknown) start_monitor(sensor_index(sensor));
     Detection d = make_detection(sensor, true, kind, t);
     if (src == kResidual && sensor != Sensor::kUnknown) {
       d.onset_time = onset_estimate(sensor_index(sensor), t);
@@ -223,10 +225,41 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
     out->push_back(d);
   } else if (before != 0 && c.sources == 0) {
     c.active = false;
-    if (sensor != Sensor::kUnknown) resync_[sensor_index(sensor)] = true;
+    if (sensor != Sensor::kUnknown) {
+      resync_[sensor_index(sensor)] = true;
+      mon_on_[sensor_index(sensor)] = false;
+    }
     Detection d = make_detection(sensor, false, c.kind, t);
     d.message = message;
     out->push_back(d);
+  }
+}
+
+void Isolator::start_monitor(int ch) {
+  // The observer in force is not reconfigured yet (that starts with the next step): the
+  // monitor continues it, driven by its own sensor.
+  mon_[ch] = ch == kV ? act_.v : act_.g;
+  mon_on_[ch] = mon_[ch].ready();
+  win_m_[ch] = Window{};
+  win_ms_[ch] = Window{};
+  mon_sign_[ch] = act_.win_sl[ch].mean() < 0 ? -1.0 : 1.0;
+  // After a constant fault f ends, the monitor's residual is c Ad^k e_ss, e_ss = -(I -
+  // Ad)^-1 L f its steady error: with g_k = c Ad^k (I - Ad)^-1 L >= 0 for all k (real
+  // poles; checked here) that transient opposes the fault, so a residual in the fault's
+  // direction is the fault itself, never its aftermath.
+  mon_ok_[ch] = false;
+  const Mat2 Ad = mon_[ch].Ad();
+  const Mat2 I_Ad = Mat2::Identity() - Ad;
+  if (mon_on_[ch] && std::abs(I_Ad.determinant()) > 1e-12 && mon_[ch].Gy().allFinite()) {
+    Vec2 e = I_Ad.partialPivLu().solve(mon_[ch].Gy());
+    const double e0 = e.norm();
+    double lo = 0.0, hi = 0.0;
+    for (int k = 0; k < 100000 && e.norm() > 1e-9 * e0; ++k) {
+      lo = std::min(lo, e(ch));
+      hi = std::max(hi, e(ch));
+      e = Ad * e;
+    }
+    mon_ok_[ch] = e0 > 0 && lo >= -1e-3 * hi;
   }
 }
 
@@ -345,7 +378,9 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
 void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok) {
   const auto usable = [&](double x, double lim) { return std::isfinite(x) && std::abs(x) <= lim; };
   if (dt > p_.stale_timeout) {
-    // A gap: restart the observers from the measurements and let them settle again.
+    // A gap: restart the observers from the measurements and let them settle again (the
+    // monitors stop: the cross residual alone holds a raised fault after a gap).
+    mon_on_ = {false, false};
     const Vec2 y0(v_ok ? s.v : b->v.x()(0), r_ok ? s.r : b->g.x()(1));
     b->v.reset(y0);
     b->g.reset(y0);
@@ -452,6 +487,16 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   if (have_prev_ && dt > 0) {
     propagate(&act_, s, dt, v_ok, r_ok);
     if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok);
+    const double dp = std::isfinite(prev_.delta) && std::abs(prev_.delta) <= p_.max_abs_delta
+                          ? prev_.delta
+                      : std::isfinite(last_delta_) ? last_delta_
+                                                   : 0.0;
+    const double dn = usable(s.delta, p_.max_abs_delta) ? s.delta : dp;
+    for (int c = 0; c < 2; ++c) {
+      if (!mon_on_[c]) continue;
+      const double y = c == kV ? prev_.v : prev_.r;
+      mon_[c].step(dt, dp, dn, y, usable(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
+    }
   }
   // A sensor whose fault cleared drives its dedicated observer again. While it was faulty
   // that observer followed the other observer's estimate of the channel, whose error is the
@@ -515,6 +560,25 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   }
   st_.J = act_.J;
   st_.D = act_.D;
+  st_.s = Vec2(raw[0], raw[1]);
+  st_.d = Vec2(raw[2], raw[3]);
+  // Monitors of raised channels: whitened like the structured residual they continue.
+  for (int c = 0; c < 2; ++c) {
+    const double y = c == kV ? s.v : s.r;
+    if (!mon_on_[c] || !(c == kV ? v_ok : r_ok)) continue;
+    const double w = (y - mon_[c].x()(c)) / act_.sigma_s(c);
+    win_m_[c].push(std::min(w * w, p_.clip * p_.clip), window_samples(dt));
+    win_ms_[c].push(std::max(-p_.clip, std::min(w, p_.clip)), window_samples(dt));
+    const FaultKind kind = cond_[c].kind;
+    const double m = std::max(0.0, mon_sign_[c] * win_ms_[c].mean());
+    // Scale errors change sign with the signal; stuck, stale and invalid channels are
+    // held by their sensor-level checks, which see exactly when they end.
+    const bool none = kind == FaultKind::kScale || kind == FaultKind::kStuck ||
+                      kind == FaultKind::kStale || kind == FaultKind::kInvalid;
+    st_.M(c) = none                                                      ? 0.0
+               : kind == FaultKind::kNoise || kind == FaultKind::kSpikes ? win_m_[c].mean()
+                                                                         : 1.0 + m * m;
+  }
   const Vec2 e(std::sqrt(std::max(0.0, st_.J(0) - 1.0)), std::sqrt(std::max(0.0, st_.J(1) - 1.0)));
   const double en = e.norm();
   st_.c_a = en > 0 ? e(0) / en : 0.0;
@@ -584,10 +648,12 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     if (a_res && !g_res && ratio(1) > 1.0) candidate = 1;
     if (g_res && !a_res && ratio(0) > 1.0) candidate = 0;
   }
+  const double enter =
+      a_res || g_res ? std::max(p_.enter_time, p_.second_fault_time) : p_.enter_time;
   for (int k = 0; k < 3; ++k) {
     if (k == candidate) {
       if (std::isnan(above_since_[k])) above_since_[k] = s.t;
-      if (s.t - above_since_[k] + eps_t >= p_.enter_time) {
+      if (s.t - above_since_[k] + eps_t >= enter) {
         const Sensor sensor = static_cast<Sensor>(k);
         const FaultKind kind = k < 2 ? classify(k) : FaultKind::kUnknown;
         if (k < 2) refine_at_[k] = s.t + 0.5 * p_.classify_window;
@@ -635,8 +701,17 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     const double rescale =
         k < 2 ? std::min(1.0, std::pow(st_.sigma_s(k) / st_.sigma_d(k), 2.0)) : 1.0;
     // In units of the leave threshold: below 1 the condition may clear.
-    const double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) / thr_exit_d(k)
-                              : ratio.maxCoeff() / p_.exit_ratio;
+    double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) / thr_exit_d(k)
+                        : ratio.maxCoeff() / p_.exit_ratio;
+    if (k < 2) {
+      // The monitor sees the fault with the structured residual's small noise: its offset
+      // in the fault's direction (a fault that ended leaves an offset against it), or for
+      // zero-mean faults its energy (their aftermath is as short as the observer's memory
+      // of the noise). A scale error changes sign with the signal: the cross residual holds.
+      if (mon_on_[k] && mon_ok_[k] && win_m_[k].v.size() >= n_full) {
+        hold = std::max(hold, st_.M(k) / (p_.exit_ratio * thr(k)));
+      }
+    }
     const double leave = k < 2 ? thr_exit_d(k) : p_.exit_ratio * thr.maxCoeff();
     if (hold < 1.0) {
       if (std::isnan(below_since_[k])) below_since_[k] = s.t;

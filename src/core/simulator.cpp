@@ -36,8 +36,11 @@ double Simulator::autopilot(double psi_ref) const {
   // Model-based PD: desired r' = wn^2 (psi_ref - psi) - 2 wn r.
   const VesselModel& m = c_.vessel;
   const double wn = m.autopilot_bandwidth;
-  const double want = wn * wn * (psi_ref - z_(2)) - 2.0 * wn * z_(1);
-  const double dc = (want - m.A(1, 0) * z_(0) - m.A(1, 1) * z_(1)) / m.B(1);
+  const bool meas = c_.autopilot_on_measurement;
+  const double v = meas ? measured_(0) : z_(0), r = meas ? measured_(1) : z_(1);
+  const double psi = meas ? measured_(2) : z_(2);
+  const double want = wn * wn * (psi_ref - psi) - 2.0 * wn * r;
+  const double dc = (want - m.A(1, 0) * v - m.A(1, 1) * r) / m.B(1);
   return std::clamp(dc, -m.max_rudder, m.max_rudder);
 }
 
@@ -149,6 +152,13 @@ bool Simulator::next(SimRow* row) {
   row->v = apply_faults(kV, t, z_(0), z_(0) + nv, &row->fault_a);
   row->r = apply_faults(kR, t, z_(1), z_(1) + nr, &row->fault_g);
   row->delta = z_(3) + (c_.sigma_delta > 0 ? c_.sigma_delta * n01_(rng_) : 0.0);
+  // What an autopilot on the INS knows at t: the last valid v and r, and the heading
+  // integrated from the measured yaw rate (trapezoidal).
+  if (std::isfinite(row->v)) measured_(0) = row->v;
+  if (std::isfinite(row->r)) {
+    if (k_ > 1) measured_(2) += 0.5 * h * (measured_(1) + row->r);
+    measured_(1) = row->r;
+  }
   return true;
 }
 

@@ -224,6 +224,7 @@ class Loader {
         {"exit_ratio", num(&is.exit_ratio)},
         {"enter_time", num(&is.enter_time)},
         {"leave_time", num(&is.leave_time)},
+        {"second_fault_time", num(&is.second_fault_time)},
         {"min_active_time", num(&is.min_active_time)},
         {"c_min", num(&is.c_min)},
         {"c_margin", num(&is.c_margin)},

@@ -46,6 +46,9 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(x.warmup_time, y.warmup_time);
   EXPECT_EQ(x.max_gap, y.max_gap);
   EXPECT_EQ(x.curvature_correction, y.curvature_correction);
+  EXPECT_EQ(x.cubic_correction, y.cubic_correction);
+  EXPECT_EQ(x.instruments, y.instruments);
+  EXPECT_EQ(x.max_std_error, y.max_std_error);
   EXPECT_EQ(x.a0, y.a0);
   EXPECT_EQ(x.min_excitation, y.min_excitation);
   EXPECT_EQ(x.settle_window, y.settle_window);
@@ -72,6 +75,8 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.exit_ratio, q.exit_ratio);
   EXPECT_EQ(p.enter_time, q.enter_time);
   EXPECT_EQ(p.leave_time, q.leave_time);
+  EXPECT_EQ(p.second_fault_time, q.second_fault_time);
+  EXPECT_EQ(p.resume_after_fault, q.resume_after_fault);
   EXPECT_EQ(p.min_active_time, q.min_active_time);
   EXPECT_EQ(p.c_min, q.c_min);
   EXPECT_EQ(p.c_margin, q.c_margin);
@@ -137,6 +142,9 @@ identification:
   warmup_time: 7
   max_gap: 2
   curvature_correction: false
+  cubic_correction: false
+  instruments: regressor
+  max_std_error: 0.2
   min_excitation: 0.5
   settle_window: 2
   settle_tolerance: 0.02
@@ -151,6 +159,8 @@ isolation:
   stuck_min_samples: 7
   spike_count: 5
   classify_window: 9
+  second_fault_time: 3.5
+  resume_after_fault: 4.5
 service:
   domain_id: 7
   mmsi: 257000000
@@ -167,6 +177,11 @@ service:
   EXPECT_EQ(c.isolation.poles_g, Vec2(-3, -4));
   EXPECT_EQ(c.isolation.stuck_min_samples, 7);
   EXPECT_EQ(c.isolation.classify_window, 9.0);
+  EXPECT_FALSE(c.identification.cubic_correction);
+  EXPECT_EQ(c.identification.instruments, Instruments::kRegressor);
+  EXPECT_EQ(c.identification.max_std_error, 0.2);
+  EXPECT_EQ(c.isolation.second_fault_time, 3.5);
+  EXPECT_EQ(c.isolation.resume_after_fault, 4.5);
 }
 
 TEST(ConfigError, UnknownKeyNamesFileKeyLineAndValue) {

@@ -52,6 +52,16 @@ inline RunResult run(const SimConfig& sim, const EngineConfig& cfg) {
   return out;
 }
 
+/// A transition into "raised" (not the re-published record of a refined kind).
+inline bool is_raise(const FaultEvent& e) {
+  return e.state == FaultState::kRaised && e.message.rfind("kind refined", 0) != 0;
+}
+/// A transition out of an active state (not the record of an acknowledgement).
+inline bool is_clear(const FaultEvent& e) {
+  return (e.state == FaultState::kClearedUnacknowledged || e.state == FaultState::kAcknowledged) &&
+         e.message.rfind("acknowledged by", 0) != 0;
+}
+
 /// How one injected fault was seen.
 struct FaultScore {
   FaultInjection fault;
@@ -60,6 +70,13 @@ struct FaultScore {
   FaultKind kind = FaultKind::kUnknown;  ///< kind of the first raise
   double delay = kNaN;                   ///< first raise - onset [s]
   double recovery = kNaN;                ///< clear of that raise - fault end [s]
+  /// Raises of the faulty sensor within the window (+grace): 1 when one fault is one event
+  /// (a raise, clear and raise again while the fault lasts is a flicker).
+  int raises = 0;
+  /// Raises of the other sensor or of "unknown" within the window (+grace): misisolations.
+  int misisolations = 0;
+  /// The faulty sensor's condition cleared before the fault ended (while it was still there).
+  bool early_clear = false;
 };
 
 inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r, double grace = 2.0) {
@@ -68,7 +85,15 @@ inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r, d
     FaultScore s;
     s.fault = f;
     for (const FaultEvent& e : r.events) {
-      if (e.state != FaultState::kRaised) continue;
+      if (!is_raise(e) || e.t < f.t_start || e.t > f.t_end + grace) continue;
+      if (e.sensor == f.sensor) {
+        ++s.raises;
+      } else {
+        ++s.misisolations;
+      }
+    }
+    for (const FaultEvent& e : r.events) {
+      if (!is_raise(e)) continue;
       if (e.t < f.t_start || e.t > f.t_end + grace) continue;
       s.detected = true;
       s.isolated = e.sensor == f.sensor;
@@ -79,16 +104,16 @@ inline std::vector<FaultScore> score(const SimConfig& sim, const RunResult& r, d
           s.kind = u.kind;
       s.delay = e.t - f.t_start;
       for (const FaultEvent& c : r.events) {
-        if (c.sensor == e.sensor && c.t > e.t &&
-            (c.state == FaultState::kClearedUnacknowledged ||
-             c.state == FaultState::kAcknowledged) &&
-            c.message.rfind("acknowledged by", 0) != 0) {
+        if (c.sensor == e.sensor && c.t > e.t && is_clear(c)) {
           s.recovery = c.t - f.t_end;
           break;
         }
       }
       break;
     }
+    // The first clear of the faulty sensor after its first raise comes after the fault ended
+    // (1e-9: a condition that ends with the fault's last sample clears at the fault's end).
+    s.early_clear = s.detected && s.isolated && s.recovery < -1e-9;
     scores.push_back(s);
   }
   return scores;

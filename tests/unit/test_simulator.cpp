@@ -667,5 +667,36 @@ TEST(Simulator, SineSteeringExcitesWithTheVesselsAmplitude) {
   }
 }
 
+TEST(Simulator, AutopilotOnTheMeasuredStateSteersOnTheSensorNoise) {
+  // GIVEN the Otter under its autopilot, steering on the true state (default) or on the
+  // measured v, r and the heading integrated from the measured r
+  const VesselModel m = shipped_vessels().front();
+  SimConfig c;
+  c.vessel = m;
+  c.rate_hz = 10.0;
+  c.duration = 200.0;
+  c.seed = 3;
+  SimConfig meas = c;
+  meas.autopilot_on_measurement = true;
+  const auto truth = simulate(c), measured = simulate(meas);
+  ASSERT_EQ(truth.size(), measured.size());
+  // THEN the measured-state autopilot moves the rudder differently (it sees the noise), but
+  //   still holds the course (heading within the turn angle of its reference)
+  double diff = 0.0, worst = 0.0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    diff = std::max(diff, std::abs(truth[i].delta_true - measured[i].delta_true));
+    worst = std::max(worst, std::abs(measured[i].psi - measured[i].psi_ref));
+  }
+  EXPECT_GT(diff, 1e-4);
+  EXPECT_LT(worst, std::abs(m.turn_angle));
+  // AND with noise-free sensors both autopilots see the same state: the same voyage (the
+  //   integrated heading differs from the true one by the trapezoid's O(h^2) error only)
+  c.sigma_v = c.sigma_r = meas.sigma_v = meas.sigma_r = 0.0;
+  const auto a = simulate(c), b = simulate(meas);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_NEAR(a[i].delta_true, b[i].delta_true, 1e-3 * m.max_rudder) << a[i].t;
+  }
+}
+
 }  // namespace
 }  // namespace usvfdi

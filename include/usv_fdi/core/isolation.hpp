@@ -46,10 +46,15 @@ struct IsolationParams {
   double exit_ratio = 0.5;        ///< leave threshold = exit_ratio * enter threshold
   double enter_time = 0.06;       ///< J_N above threshold this long raises (at least 1 sample) [s]
   double leave_time = 1.0;        ///< below the leave threshold this long clears [s]
-  double min_active_time = 3.0;   ///< a residual fault stays raised at least this long [s]
-  double c_min = 0.8;             ///< isolation needs C_i >= c_min ...
-  double c_margin = 0.3;          ///< ... and C_i - C_other >= c_margin; else sensor unknown
-  double resume_time = 2.0;       ///< quiet time before identification resumes [s]
+  /// While one sensor's fault is raised, the other raises after J_N stayed above its
+  /// threshold this long. Its structured entry is blind to the first fault, but the design
+  /// in force cannot be renewed without healthy data, so its model mismatch (largest in
+  /// turns, for about a second) grows as the estimate it was made from ages [s].
+  double second_fault_time = 2.0;
+  double min_active_time = 3.0;  ///< a residual fault stays raised at least this long [s]
+  double c_min = 0.8;            ///< isolation needs C_i >= c_min ...
+  double c_margin = 0.3;         ///< ... and C_i - C_other >= c_margin; else sensor unknown
+  double resume_time = 2.0;      ///< quiet time before identification resumes [s]
   /// ... and after a fault condition cleared: a fault that comes and goes with the signal
   /// (a scale error is invisible while the vessel holds its course) must not reach the
   /// estimate of A in its quiet spells [s].
@@ -111,6 +116,11 @@ struct IsolatorStatus {
   Vec2 thresholds_d = Vec2::Zero();  ///< thresholds on D_N (hold: exit_ratio x)
   Vec2 J = Vec2::Zero();             ///< windowed statistic per channel (structured)
   Vec2 D = Vec2::Zero();             ///< windowed statistic per channel (cross)
+  /// Monitor statistic per raised channel: the signed offset of its monitor residual in
+  /// the fault's direction as a mean square (1 + m^2), or its energy for noise and spikes.
+  Vec2 M = Vec2::Zero();
+  Vec2 s = Vec2::Zero();  ///< latest structured residual [m/s, rad/s] (NaN where unusable)
+  Vec2 d = Vec2::Zero();  ///< latest cross residual, the fault estimate [m/s, rad/s]
   double c_a = 0.0, c_g = 0.0;
   InputHealth input;
   std::uint64_t samples = 0;
@@ -235,6 +245,14 @@ class Isolator {
   std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
   std::array<double, 3> raised_at_{kNaN, kNaN, kNaN};  ///< time of the residual raise
   double last_delta_ = kNaN;
+  // Holding a raised residual fault (see residual_checks).
+  std::array<DedicatedObserver, 2> mon_;      ///< monitors: the observer, not reconfigured
+  std::array<bool, 2> mon_on_{false, false};  ///< monitor running (channel raised)
+  std::array<bool, 2> mon_ok_{false, false};  ///< its post-fault transient opposes the fault
+  std::array<double, 2> mon_sign_{1.0, 1.0};  ///< the fault's sign at the raise
+  std::array<Window, 2> win_m_;               ///< clipped squared whitened monitor residual
+  std::array<Window, 2> win_ms_;              ///< signed whitened monitor residual
+  void start_monitor(int ch);
   std::array<double, 2> refine_at_{kNaN, kNaN};  ///< when to refine a raised fault's kind
 };
 

@@ -43,7 +43,11 @@ struct SimConfig {
   Steering steering = Steering::kAutopilot;
   double sine_amplitude = -1;  ///< [rad]; < 0: the vessel's
   double sine_frequency = -1;  ///< [rad/s]; < 0: the vessel's
-  int substeps = 10;           ///< RK4 steps per sample
+  /// The autopilot steers on the MEASURED state (v and r as the INS gives them, heading
+  /// integrated from the measured r, as an autopilot with a gyro-based heading does), so
+  /// the rudder carries a filtered trace of the sensor noise; false: on the true state.
+  bool autopilot_on_measurement = false;
+  int substeps = 10;  ///< RK4 steps per sample
   std::vector<FaultInjection> faults;
 };
 
@@ -74,6 +78,7 @@ class Simulator {
   std::uniform_real_distribution<double> u01_{0.0, 1.0};
   State z_ = State::Zero();
   double psi_ref_ = 0.0, target_ = 0.0;
+  Eigen::Vector3d measured_ = Eigen::Vector3d::Zero();  ///< last valid v, r; integrated heading
   std::uint64_t k_ = 0;
   double sigma_[2] = {0, 0};
   std::vector<double> held_;  ///< stuck values per injection
