@@ -69,10 +69,10 @@ std::string health_json(const HealthReport& r) {
      << ", \"mmsi\": " << r.mmsi << ", \"state\": " << io::json_string(r.state)
      << ", \"reason\": " << io::json_string(r.reason) << ", \"period\": " << num(r.period)
      << ", \"stall_limit\": " << num(r.stall_limit)
-     << ", \"threads\": {\"isolation\": " << num(r.live.isolation)
-     << ", \"identification\": " << num(r.live.identification)
-     << ", \"publisher\": " << num(r.live.publisher)
-     << "}, \"ins_age\": " << (r.live.ins_age < 0 ? "null" : num(r.live.ins_age))
+     << ", \"isolation_thread_age\": " << num(r.live.isolation)
+     << ", \"ident_thread_age\": " << num(r.live.identification)
+     << ", \"publisher_thread_age\": " << num(r.live.publisher)
+     << ", \"ins_age\": " << (r.live.ins_age < 0 ? "null" : num(r.live.ins_age))
      << ", \"rudder_age\": " << (r.live.rudder_age < 0 ? "null" : num(r.live.rudder_age))
      << ", \"samples\": " << r.samples << ", \"converged\": " << (r.converged ? "true" : "false")
      << ", \"armed\": " << (r.armed ? "true" : "false")
@@ -140,6 +140,7 @@ HealthVerdict check_health_file(const std::string& path, double max_age, double 
   std::string state, reason;
   double threads[3] = {0, 0, 0};
   const char* thread_names[3] = {"isolation", "identification", "publisher"};
+  const char* thread_keys[3] = {"isolation_thread_age", "ident_thread_age", "publisher_thread_age"};
   std::uint64_t samples = 0;
   std::string flags;
   try {
@@ -150,7 +151,7 @@ HealthVerdict check_health_file(const std::string& path, double max_age, double 
     period = root["period"].as<double>();
     state = root["state"].as<std::string>();
     reason = root["reason"].as<std::string>();
-    for (int i = 0; i < 3; ++i) threads[i] = root["threads"][thread_names[i]].as<double>();
+    for (int i = 0; i < 3; ++i) threads[i] = root[thread_keys[i]].as<double>();
     samples = root["samples"].as<std::uint64_t>();
     for (const auto& n : root["input_flags"]) {
       flags += (flags.empty() ? "" : ",") + n.as<std::string>();

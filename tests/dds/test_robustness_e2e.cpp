@@ -327,13 +327,15 @@ TEST(SlowSubscribers, AStalledOrSlowSubscriberNeverBlocksTheIsolationThread) {
     std::ifstream h(health);
     std::stringstream text;
     text << h.rdbuf();
-    const auto at = text.str().find("\"isolation\": ");
+    const std::string iso_key = "\"isolation_thread_age\": ";
+    const std::string pub_key = "\"publisher_thread_age\": ";
+    const auto at = text.str().find(iso_key);
     if (at != std::string::npos) {
-      max_iso_age = std::max(max_iso_age, std::stod(text.str().substr(at + 13)));
+      max_iso_age = std::max(max_iso_age, std::stod(text.str().substr(at + iso_key.size())));
     }
-    const auto pub = text.str().find("\"publisher\": ");
+    const auto pub = text.str().find(pub_key);
     if (pub != std::string::npos) {
-      max_pub_age = std::max(max_pub_age, std::stod(text.str().substr(pub + 13)));
+      max_pub_age = std::max(max_pub_age, std::stod(text.str().substr(pub + pub_key.size())));
     }
   }
   const double window = std::chrono::duration<double>(Clock::now() - w1).count();

@@ -4,11 +4,11 @@
 // period with one JSON object:
 //   {"version": 1, "time": <unix s>, "pid": .., "mmsi": .., "state": "starting"|"running"|
 //    "failed"|"stopped", "reason": "..", "period": <s>, "stall_limit": <s>,
-//    "threads": {"isolation": <s>, "identification": <s>, "publisher": <s>},
+//    "isolation_thread_age": <s>, "ident_thread_age": <s>, "publisher_thread_age": <s>,
 //    "ins_age": <s or null>, "rudder_age": <s or null>, "samples": .., "converged": ..,
 //    "armed": .., "input_flags": [..], "identification_paused": [..], "isolation_paused": [..],
 //    "dropped": .., "fault_event_readers": .., "state_file": "..", "state_error": ".."}
-// "threads" are the seconds since each pipeline thread last went round its loop (an idle
+// The thread ages are the seconds since each pipeline thread last went round its loop (an idle
 // thread goes round every 50-100 ms): a wedged thread's age grows and the state becomes
 // "failed" once it passes stall_limit. Input problems (a silent INS or rudder, bad samples),
 // missing readers and raised faults are reported but never make the sidecar unhealthy: a
