@@ -88,6 +88,42 @@ std::string json_row(const Row& r) {
   return os.str();
 }
 
+/// ["a","b"] from a comma-separated list of names.
+std::string json_names(const std::string& names) {
+  std::string out = "[";
+  std::size_t start = 0;
+  while (start < names.size()) {
+    std::size_t end = names.find(',', start);
+    if (end == std::string::npos) end = names.size();
+    if (out.size() > 1) out += ",";
+    out += io::json_string(names.substr(start, end - start));
+    start = end + 1;
+  }
+  return out + "]";
+}
+
+/// One line on the inputs of a vessel: problems, counters, pauses.
+std::string inputs_line(const fdi::FdiStatus& s) {
+  std::string flags = input_flag_names(s.input_flags());
+  char counts[200];
+  std::snprintf(counts, sizeof counts,
+                "rejected timestamps %llu, invalid values %llu, gaps %llu, reordered %llu, queue "
+                "drops %llu",
+                static_cast<unsigned long long>(s.rejected_timestamps()),
+                static_cast<unsigned long long>(s.invalid_values()),
+                static_cast<unsigned long long>(s.gaps()),
+                static_cast<unsigned long long>(s.reordered()),
+                static_cast<unsigned long long>(s.dropped_inputs()));
+  std::string line = "inputs: " + (flags.empty() ? std::string("ok") : flags) + " (" + counts + ")";
+  line += s.identification_paused() == 0
+              ? std::string("; identification running")
+              : "; identification paused: " + pause_reason_names(s.identification_paused());
+  line += s.isolation_paused() == 0
+              ? std::string("; isolation running")
+              : "; isolation paused: " + pause_reason_names(s.isolation_paused());
+  return line;
+}
+
 std::string json_status(const VesselStatus& v) {
   const fdi::FdiStatus& s = v.st;
   std::ostringstream os;
@@ -100,6 +136,12 @@ std::string json_status(const VesselStatus& v) {
      << ",\"ins_healthy\":" << (s.ins_healthy() ? "true" : "false")
      << ",\"rudder_healthy\":" << (s.rudder_healthy() ? "true" : "false")
      << ",\"samples\":" << s.samples() << ",\"dropped\":" << s.dropped()
+     << ",\"input_flags\":" << json_names(input_flag_names(s.input_flags()))
+     << ",\"rejected_timestamps\":" << s.rejected_timestamps()
+     << ",\"invalid_values\":" << s.invalid_values() << ",\"gaps\":" << s.gaps()
+     << ",\"reordered\":" << s.reordered() << ",\"dropped_inputs\":" << s.dropped_inputs()
+     << ",\"identification_paused\":" << json_names(pause_reason_names(s.identification_paused()))
+     << ",\"isolation_paused\":" << json_names(pause_reason_names(s.isolation_paused()))
      << ",\"age_s\":" << io::json_number(wall_now() - v.written)
      << ",\"alive\":" << (v.alive ? "true" : "false")
      << ",\"message\":" << io::json_string(s.message().to_string()) << "}";
@@ -133,6 +175,7 @@ void print_table(const std::map<RowKey, Row>& rows,
           s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0],
           s.a()[1], s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
           static_cast<unsigned long long>(s.dropped()), s.message().c_str());
+      std::printf("  %s\n", inputs_line(s).c_str());
     }
   }
   std::fflush(stdout);

@@ -1,6 +1,9 @@
 // usv-fdi run: the FDI sidecar of one vessel on Fast DDS.
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -8,6 +11,7 @@
 
 #include "commands.hpp"
 #include "dds_options.hpp"
+#include "usv_fdi/dds_service/health.hpp"
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
 
@@ -17,7 +21,67 @@ namespace {
 struct RunArgs {
   DdsCli dds;
   std::optional<std::uint32_t> mmsi;
+  std::optional<std::string> state_dir;
+  bool no_state = false;
+  std::string health_file;
   const CLI::App* root = nullptr;
+};
+
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+/// Writes the health file (if one is configured), logging a failure once per distinct error.
+class HealthWriter {
+ public:
+  HealthWriter(std::string path, std::uint32_t mmsi, double period) : path_(std::move(path)) {
+    r_.mmsi = mmsi;
+    r_.pid = static_cast<long>(::getpid());
+    r_.period = period;
+    // A thread that has not gone round its loop for this long is stalled (an idle one goes
+    // round every 50-100 ms; a DDS write blocks at most 100 ms).
+    r_.stall_limit = std::max(5.0, 3.0 * period);
+  }
+  bool enabled() const { return !path_.empty(); }
+  void write(const std::string& state, const std::string& reason,
+             const service::FdiService* svc = nullptr) {
+    if (!enabled()) return;
+    r_.time = unix_now();
+    r_.state = state;
+    r_.reason = reason;
+    if (svc != nullptr) {
+      const PipelineStatus st = svc->status();
+      r_.live = svc->liveness();
+      r_.samples = st.samples;
+      r_.converged = st.estimate.converged;
+      r_.armed = st.isolation.armed;
+      r_.input_flags = st.input_flags;
+      r_.identification_paused = st.identification_paused;
+      r_.isolation_paused = st.isolation_paused;
+      r_.dropped = st.dropped_inputs + st.dropped_ident + st.dropped_output;
+      r_.fault_event_readers = svc->matches().event_readers;
+      r_.state_file = svc->state_file();
+      r_.state_error = svc->state_error();
+      if (state == "running") service::judge_threads(&r_);
+    }
+    if (r_.state == "failed" && r_.reason != logged_failure_) {
+      spdlog::error("health: {}", r_.reason);
+      logged_failure_ = r_.reason;
+    }
+    std::string error;
+    if (!service::write_health_file(path_, r_, &error)) {
+      if (error != logged_error_) spdlog::error("health file: {}", error);
+      logged_error_ = error;
+    } else if (!logged_error_.empty()) {
+      spdlog::info("health file {} written again", path_);
+      logged_error_.clear();
+    }
+  }
+
+ private:
+  std::string path_;
+  service::HealthReport r_;
+  std::string logged_error_, logged_failure_;
 };
 
 void log_line(int level, const std::string& msg) {
@@ -51,6 +115,15 @@ int run_service(const RunArgs& a) {
     return kExitConfig;
   }
   if (a.mmsi) cfg.mmsi = *a.mmsi;
+  if (a.state_dir) {
+    cfg.state_dir = *a.state_dir;
+    cfg.state_dir_explicit = true;
+  }
+  if (a.no_state) {
+    cfg.state_dir.clear();
+    cfg.state_dir_explicit = true;
+  }
+  if (!a.health_file.empty()) cfg.health_file = a.health_file;
   if (cfg.mmsi == 0) {
     spdlog::error("{}: service.mmsi is not set (give the vessel's MMSI there or with --mmsi)",
                   a.dds.config);
@@ -60,22 +133,35 @@ int run_service(const RunArgs& a) {
   if (a.root == nullptr || a.root->get_option("--log-level")->count() == 0) {
     spdlog::set_level(spdlog::level::from_str(cfg.log_level));
   }
+  const double period = cfg.pipeline.status_period;
+  HealthWriter health(cfg.health_file, cfg.mmsi, period);
+  health.write("starting", "creating the DDS participant");
   std::unique_ptr<service::FdiService> svc;
   try {
     svc = std::make_unique<service::FdiService>(cfg, log_line);
   } catch (const std::exception& e) {
     spdlog::error("cannot start the DDS service: {}", e.what());
+    health.write("failed", std::string("cannot start the DDS service: ") + e.what());
     return kExitFailure;
   }
   svc->start();
+  health.write("running", "", svc.get());
   spdlog::info(
       "sidecar for MMSI {} on DDS domain {} (participant profile {}, QoS {}, {} inputs, "
-      "status every {:g} s): waiting for INS and rudder",
+      "status every {:g} s, state {}, health file {}): waiting for INS and rudder",
       cfg.mmsi, cfg.dds.domain_id, cfg.dds.participant_profile, cfg.dds.profiles_file,
-      cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", cfg.pipeline.status_period);
+      cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", period,
+      svc->state_file().empty() ? std::string("not persisted") : svc->state_file(),
+      cfg.health_file.empty() ? std::string("none") : cfg.health_file);
   int sig = 0;
   service::FdiService::Matches seen;
-  while ((sig = wait_for_stop_signal(0.5)) == 0) {
+  auto last_health = std::chrono::steady_clock::now();
+  while ((sig = wait_for_stop_signal(std::min(0.5, period))) == 0) {
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - last_health).count() >= period) {
+      last_health = now;
+      health.write("running", "", svc.get());
+    }
     const service::FdiService::Matches m = svc->matches();
     if (m != seen) {
       spdlog::info(
@@ -87,6 +173,7 @@ int run_service(const RunArgs& a) {
   }
   const auto t0 = std::chrono::steady_clock::now();
   spdlog::info("signal {}: stopping", sig);
+  health.write("stopped", "signal " + std::to_string(sig));
   svc->stop();
   const PipelineStatus st = svc->status();
   spdlog::info(
@@ -110,6 +197,15 @@ void register_run_command(CommandRegistry& registry) {
       ->check(CLI::Range(1u, 999999999u));
   sub->add_flag("--reliable-inputs", args.dds.reliable,
                 "RELIABLE INS and rudder readers (pair with sim --publish --reliable)");
+  sub->add_option("--state-dir", args.state_dir,
+                  "directory of the latched-fault journal (overrides service.state_dir; default "
+                  "/var/lib/usv-fdi if it exists); created if missing");
+  sub->add_flag("--no-state", args.no_state,
+                "do not persist latched faults (they will not survive a restart)")
+      ->excludes("--state-dir");
+  sub->add_option("--health-file", args.health_file,
+                  "rewrite this JSON file every status period for `usv-fdi health` (overrides "
+                  "service.health_file)");
 }
 
 }  // namespace usvfdi::app

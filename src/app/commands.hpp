@@ -11,6 +11,7 @@ void register_vessels_command(CommandRegistry& registry);  // cmd_vessels.cpp
 #ifdef USV_FDI_APP_WITH_DDS
 void register_run_command(CommandRegistry& registry);      // cmd_run.cpp (DDS service)
 void register_monitor_command(CommandRegistry& registry);  // cmd_monitor.cpp (DDS subscriber)
+void register_health_command(CommandRegistry& registry);   // cmd_health.cpp (health check)
 #endif
 
 }  // namespace usvfdi::app

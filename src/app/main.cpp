@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
 #ifdef USV_FDI_APP_WITH_DDS  // defined by src/app/CMakeLists.txt once the DDS commands exist
   register_run_command(registry);
   register_monitor_command(registry);
+  register_health_command(registry);
 #endif
 
   try {

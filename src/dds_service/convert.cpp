@@ -4,6 +4,23 @@
 
 namespace usvfdi::service {
 
+// The pipeline's flag values are the IDL's constants (FdiStatus carries them as they are).
+static_assert(kInputInsSilent == fdi::INPUT_INS_SILENT &&
+                  kInputRudderMissing == fdi::INPUT_RUDDER_MISSING &&
+                  kInputAccelUnusable == fdi::INPUT_ACCELEROMETER_UNUSABLE &&
+                  kInputGyroUnusable == fdi::INPUT_GYRO_UNUSABLE &&
+                  kInputBadTimestamps == fdi::INPUT_BAD_TIMESTAMPS &&
+                  kInputInvalidValues == fdi::INPUT_INVALID_VALUES &&
+                  kInputGaps == fdi::INPUT_GAPS && kInputReordered == fdi::INPUT_REORDERED &&
+                  kInputQueueDrops == fdi::INPUT_QUEUE_DROPS,
+              "InputFlag differs from idl/usv_fdi.idl INPUT_*");
+static_assert(kPauseNotArmed == fdi::PAUSE_NOT_ARMED && kPauseLearning == fdi::PAUSE_LEARNING &&
+                  kPauseRudderMissing == fdi::PAUSE_RUDDER_MISSING &&
+                  kPauseInsUnusable == fdi::PAUSE_INS_UNUSABLE &&
+                  kPauseInsSilent == fdi::PAUSE_INS_SILENT && kPauseFault == fdi::PAUSE_FAULT &&
+                  kPauseObserver == fdi::PAUSE_OBSERVER,
+              "PauseReason differs from idl/usv_fdi.idl PAUSE_*");
+
 fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {
   fdi::FaultEvent d;
   d.mmsi(mmsi);
@@ -65,9 +82,19 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   d.rudder_healthy(in.delta_ok);
   d.samples(s.samples);
   d.dropped(s.dropped_inputs + s.dropped_ident + s.dropped_output);
+  d.input_flags(s.input_flags);
+  d.rejected_timestamps(s.rejected_timestamps);
+  d.invalid_values(s.invalid_values);
+  d.gaps(s.gaps);
+  d.reordered(s.reordered);
+  d.dropped_inputs(s.dropped_inputs);
+  d.identification_paused(s.identification_paused);
+  d.isolation_paused(s.isolation_paused);
   std::string msg;
   if (s.ins_silent) msg += "INS silent; ";
   if (!in.delta_ok) msg += "rudder missing: identification and isolation paused; ";
+  if (!in.v_ok) msg += "accelerometer channel unusable; ";
+  if (!in.r_ok) msg += "gyro channel unusable; ";
   if (!s.isolation.observer_problem.empty()) msg += s.isolation.observer_problem + "; ";
   if (!s.isolation.armed) {
     msg += s.estimate.converged ? "converged, arming; " : "identifying A; ";
@@ -76,6 +103,7 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   } else {
     msg += "armed; ";
   }
+  if (s.identification_paused & kPauseFault) msg += "identification frozen (fault); ";
   if (s.rejected > 0) msg += std::to_string(s.rejected) + " samples rejected; ";
   d.message(msg.substr(0, 127).c_str());
   return d;

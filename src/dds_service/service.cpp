@@ -1,7 +1,10 @@
 #include "usv_fdi/dds_service/service.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <ctime>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -66,7 +69,22 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   status_writer_ = &dds_->create_writer(dds::TopicId::kStatus, dds::profiles::kStatusWriter);
   const std::uint32_t mmsi = cfg_.mmsi;
   const IsolationParams iso = cfg_.engine.isolation;
+  open_journal();
   auto on_event = [this, mmsi](const FaultEvent& e) {
+    // Persisted before it is published: a sequence a subscriber has seen is in the file.
+    if (journal_) {
+      if (!journal_->record(e)) {
+        const std::string err = journal_->last_error();
+        if (err != journal_error_logged_ && log_) {
+          log_(3, "state: cannot save the latched fault state: " + err +
+                      " (events are still published, but will not survive a restart)");
+        }
+        journal_error_logged_ = err;
+      } else if (!journal_error_logged_.empty()) {
+        if (log_) log_(1, "state: saved again to " + journal_->path());
+        journal_error_logged_.clear();
+      }
+    }
     dds::write(*event_writer_, to_dds(e, mmsi));
     if (log_) {
       char head[192];
@@ -81,6 +99,7 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     dds::write(*status_writer_, to_dds(s, mmsi, iso));
   };
   pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, cfg_.pipeline, on_event, on_status, log_);
+  for (const FaultEvent& e : restored_) pipeline_->restore(e);
   listener_ = std::make_unique<Listener>(pipeline_.get(), mmsi);
   DataReader& ins = dds_->create_reader(dds::TopicId::kIns,
                                         cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
@@ -95,6 +114,95 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
 }
 
 FdiService::~FdiService() { stop(); }
+
+namespace {
+
+std::string utc(double unix_s) {
+  const std::time_t t = static_cast<std::time_t>(unix_s);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+}  // namespace
+
+void FdiService::open_journal() {
+  namespace fs = std::filesystem;
+  const auto say = [this](int level, const std::string& msg) {
+    if (log_) log_(level, "state: " + msg);
+  };
+  const std::string& dir = cfg_.state_dir;
+  if (dir.empty()) {
+    say(2, "not persisted (no state directory): latched faults will NOT survive a restart");
+    return;
+  }
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    if (!cfg_.state_dir_explicit) {
+      say(2, "not persisted: the default state directory " + dir +
+                 " does not exist; latched faults will NOT survive a restart (set "
+                 "service.state_dir or --state-dir)");
+      return;
+    }
+    fs::create_directories(dir, ec);
+    if (ec) {
+      say(3, "cannot create the state directory " + dir + ": " + ec.message() +
+                 "; latched faults will NOT survive a restart");
+      return;
+    }
+    say(1, "created the state directory " + dir);
+  }
+  const std::string path = StateJournal::path_for(dir, cfg_.mmsi);
+  journal_ = std::make_unique<StateJournal>(path, cfg_.mmsi);
+  fs::remove(path + ".tmp", ec);  // a save interrupted by a crash; the file itself is whole
+  StateJournal::Contents c;
+  std::string error;
+  switch (StateJournal::load(path, cfg_.mmsi, &c, &error)) {
+    case StateJournal::LoadResult::kMissing:
+      say(1, "no state file " + path + " yet: nothing to restore");
+      break;
+    case StateJournal::LoadResult::kError: {
+      std::string why;
+      const std::string aside = StateJournal::set_aside(path, &why);
+      say(3, "cannot restore latched faults: " + error + "; " +
+                 (aside.empty() ? "could not move it aside (" + why + ")"
+                                : "moved it aside to " + aside) +
+                 "; starting with no latched faults");
+      break;
+    }
+    case StateJournal::LoadResult::kLoaded: {
+      restored_ = c.events;
+      for (const FaultEvent& e : restored_) journal_->seed(e);
+      const double now =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+              .count();
+      std::string list;
+      for (const FaultEvent& e : restored_) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "%s #%llu %s (%s, raised at t=%.2f s)", to_string(e.sensor),
+                      static_cast<unsigned long long>(e.sequence), to_string(e.state),
+                      to_string(e.kind), e.detection_time);
+        list += (list.empty() ? "" : "; ") + std::string(buf);
+      }
+      char age[64];
+      std::snprintf(age, sizeof age, "%.1f s ago", now - c.written);
+      say(1, "restored " + std::to_string(restored_.size()) + " fault instance(s) from " + path +
+                 " (written " + utc(c.written) + ", " + age + ")" +
+                 (restored_.empty() ? std::string()
+                                    : ": " + list + "; re-published with the same sequences"));
+      break;
+    }
+  }
+  // Write it now: a directory that cannot be written is reported at start, not at the first
+  // fault.
+  if (!journal_->save()) {
+    journal_error_logged_ = journal_->last_error();
+    say(3, "cannot write the state file: " + journal_error_logged_ +
+               "; latched faults will NOT survive a restart until this is fixed");
+  }
+}
 
 FdiService::Matches FdiService::matches() const {
   Matches m;

@@ -1,6 +1,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -61,9 +62,15 @@ ServiceConfig load_service_config(const std::string& path) {
   const YAML::Node root = YAML::LoadFile(path);
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   std::string qos = default_qos_profiles();
+  cfg.state_dir = kDefaultStateDir;
+  const auto relative_to_config = [&](const std::string& p) {
+    const std::filesystem::path fp(p);
+    return (fp.is_absolute() ? fp : dir / fp).lexically_normal().string();
+  };
   const YAML::Node s = root["service"];
   if (s && !s.IsMap()) fail(path, s, "", "must be a mapping");
   bool have_mmsi = false;
+  YAML::Node input_timeout_node;
   if (s) {
     for (const auto& kv : s) {
       const std::string key = kv.first.as<std::string>();
@@ -124,18 +131,43 @@ ServiceConfig load_service_config(const std::string& path) {
         const auto n = get<long long>(path, v, key, "a queue length");
         if (n < 1 || n > 1000000) fail(path, v, key, "must be 1..1000000");
         cfg.pipeline.input_capacity = static_cast<std::size_t>(n);
-      } else if (key == "rudder_wait" || key == "rudder_timeout" || key == "input_timeout") {
+      } else if (key == "rudder_wait" || key == "rudder_timeout" || key == "input_timeout" ||
+                 key == "restore_recheck") {
         const double x = get<double>(path, v, key, "a time in seconds");
         if (!(x > 0) || !std::isfinite(x)) fail(path, v, key, "must be a positive time in s");
         (key == "rudder_wait"      ? cfg.pipeline.rudder_wait
          : key == "rudder_timeout" ? cfg.pipeline.rudder_timeout
-                                   : cfg.pipeline.input_timeout) = x;
+         : key == "input_timeout"  ? cfg.pipeline.input_timeout
+                                   : cfg.pipeline.restore_recheck) = x;
+        if (key == "input_timeout") input_timeout_node = v;
+      } else if (key == "state_dir") {
+        // null or "": no persistence.
+        const std::string d =
+            v.IsNull() ? std::string() : get<std::string>(path, v, key, "a directory");
+        cfg.state_dir = d.empty() ? d : relative_to_config(d);
+        cfg.state_dir_explicit = true;
+        std::error_code ec;
+        if (!cfg.state_dir.empty() && std::filesystem::exists(cfg.state_dir, ec) &&
+            !std::filesystem::is_directory(cfg.state_dir, ec)) {
+          fail(path, v, key, "not a directory: " + cfg.state_dir);
+        }
+      } else if (key == "health_file") {
+        const std::string f =
+            v.IsNull() ? std::string() : get<std::string>(path, v, key, "a file path");
+        cfg.health_file = f.empty() ? f : relative_to_config(f);
       } else {
         fail(path, kv.first, key, "unknown key");
       }
     }
   }
   (void)have_mmsi;
+  // A silent INS is reported as stale faults: the silence must outlast the stale check.
+  if (input_timeout_node && cfg.pipeline.input_timeout < cfg.engine.isolation.stale_timeout) {
+    char why[128];
+    std::snprintf(why, sizeof why, "must be at least isolation.stale_timeout (%g s)",
+                  cfg.engine.isolation.stale_timeout);
+    fail(path, input_timeout_node, "input_timeout", why);
+  }
   cfg.dds.profiles_file = qos;
   return cfg;
 }

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
+#include <initializer_list>
+#include <stdexcept>
+#include <utility>
 
 namespace usvfdi {
 
@@ -35,10 +39,16 @@ double SampleAssembler::delta_at(double t) const {
     const RudderInput& b = rudder_[i];
     if (b.stamp == t) return b.delta;
     if (i > 0) {
+      // Interpolate between neighbours within rudder_timeout; across a longer gap in the
+      // rudder stream only the near side is used (held), and nothing when neither is near.
       const RudderInput& a = rudder_[i - 1];
-      if (t - a.stamp > timeout_ && b.stamp - t > timeout_) return kNaN;
-      const double w = (t - a.stamp) / (b.stamp - a.stamp);
-      return a.delta + w * (b.delta - a.delta);
+      const bool a_near = t - a.stamp <= timeout_, b_near = b.stamp - t <= timeout_;
+      if (a_near && b_near) {
+        const double w = (t - a.stamp) / (b.stamp - a.stamp);
+        return a.delta + w * (b.delta - a.delta);
+      }
+      if (a_near) return a.delta;
+      return b_near ? b.delta : kNaN;
     }
     return b.stamp - t <= timeout_ ? b.delta : kNaN;
   }
@@ -61,6 +71,57 @@ void SampleAssembler::drain(std::vector<Sample>* out, bool flush) {
   }
 }
 
+// ---------------------------------------------------------------- flags
+
+namespace {
+
+std::string bit_names(std::uint32_t bits,
+                      std::initializer_list<std::pair<std::uint32_t, const char*>> table) {
+  std::string out;
+  for (const auto& [bit, name] : table) {
+    if (!(bits & bit)) continue;
+    if (!out.empty()) out += ",";
+    out += name;
+  }
+  return out;
+}
+
+std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, format, a, b, c);
+  return buf;
+}
+
+int index_of(Sensor s) { return static_cast<int>(s); }
+
+bool sensor_level(FaultKind k) {
+  return k == FaultKind::kStale || k == FaultKind::kStuck || k == FaultKind::kInvalid;
+}
+
+}  // namespace
+
+std::string input_flag_names(std::uint32_t flags) {
+  return bit_names(flags, {{kInputInsSilent, "ins_silent"},
+                           {kInputRudderMissing, "rudder_missing"},
+                           {kInputAccelUnusable, "accelerometer_unusable"},
+                           {kInputGyroUnusable, "gyro_unusable"},
+                           {kInputBadTimestamps, "bad_timestamps"},
+                           {kInputInvalidValues, "invalid_values"},
+                           {kInputGaps, "gaps"},
+                           {kInputReordered, "reordered"},
+                           {kInputQueueDrops, "queue_drops"}});
+}
+
+std::string pause_reason_names(std::uint32_t reasons) {
+  return bit_names(reasons, {{kPauseNotArmed, "not_armed"},
+                             {kPauseLearning, "learning"},
+                             {kPauseRudderMissing, "rudder_missing"},
+                             {kPauseInsUnusable, "ins_unusable"},
+                             {kPauseInsSilent, "ins_silent"},
+                             {kPauseFault, "fault"},
+                             {kPauseObserver, "observer"}});
+}
+
 // ---------------------------------------------------------------- FdiPipeline
 
 FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, EventSink on_event,
@@ -81,13 +142,28 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
 FdiPipeline::~FdiPipeline() { stop(); }
 
 void FdiPipeline::restore(const FaultEvent& ev) {
-  latches_[static_cast<int>(ev.sensor)].restore(ev);
+  if (started_) throw std::logic_error("FdiPipeline::restore() after start()");
+  const int i = index_of(ev.sensor);
+  if (i < 0 || i > 2) throw std::invalid_argument("FdiPipeline::restore(): unknown sensor");
+  latches_[i].restore(ev);
   restored_.push_back(ev);
+  {
+    std::lock_guard<std::mutex> lock(latest_m_);
+    latest_[i] = ev;
+  }
+  recheck_[i] = Recheck{};
+  if (ev.state == FaultState::kRaised || ev.state == FaultState::kActiveAcknowledged) {
+    recheck_[i].pending = true;
+    recheck_[i].kind = ev.kind;
+  }
 }
 
 void FdiPipeline::start() {
   if (started_) return;
   started_ = true;
+  started_at_ = std::chrono::steady_clock::now();
+  const std::int64_t now = now_ns();
+  beat_iso_ = beat_ident_ = beat_pub_ = now;
   pub_thread_ = std::thread([this] { publisher_loop(); });
   ident_thread_ = std::thread([this] { identification_loop(); });
   iso_thread_ = std::thread([this] { isolation_loop(); });
@@ -113,21 +189,113 @@ void FdiPipeline::log(int level, const std::string& msg) const {
   if (on_log_) on_log_(level, msg);
 }
 
-void FdiPipeline::emit(const FaultEvent& ev) { output_.push(ev); }
+void FdiPipeline::emit(const FaultEvent& ev) {
+  {
+    std::lock_guard<std::mutex> lock(latest_m_);
+    latest_[index_of(ev.sensor)] = ev;
+  }
+  output_.push(ev);
+}
+
+void FdiPipeline::accept_ins(const InsInput& in) {
+  if (!std::isfinite(in.stamp)) {
+    ++problems_.bad_stamps;
+    problems_.example(InputProblems::kStamp,
+                      fmt("an INS sample with stamp %g was dropped", in.stamp));
+    return;
+  }
+  for (int c = 0; c < 2; ++c) {
+    const bool flagged_valid = c == 0 ? in.v_valid : in.r_valid;
+    const double x = c == 0 ? in.v : in.r;
+    if (flagged_valid && std::isnan(x)) {
+      ++problems_.invalid;  // Inf and absurd magnitudes are counted by the engine
+      problems_.example(InputProblems::kValue,
+                        std::string(c == 0 ? "v" : "r") +
+                            fmt(" = NaN flagged valid at t=%.3f s (used as missing)", in.stamp));
+    }
+  }
+  if (in.stamp < newest_ins_stamp_) {
+    ++problems_.reordered;
+    problems_.example(InputProblems::kOrder,
+                      fmt("INS t=%.3f s arrived after t=%.3f s", in.stamp, newest_ins_stamp_));
+  }
+  newest_ins_stamp_ = std::max(newest_ins_stamp_, in.stamp);
+  assembler_.add_ins(in);
+}
+
+void FdiPipeline::accept_rudder(const RudderInput& in) {
+  if (!std::isfinite(in.stamp)) {
+    ++problems_.bad_stamps;
+    problems_.example(InputProblems::kStamp,
+                      fmt("a rudder sample with stamp %g was dropped", in.stamp));
+    return;
+  }
+  const double limit = cfg_.isolation.max_abs_delta;
+  if (in.valid && !(std::abs(in.delta) <= limit)) {
+    ++problems_.invalid;
+    problems_.example(InputProblems::kValue,
+                      fmt("rudder angle %g rad at t=%.3f s (|delta| > max_abs_delta %g) dropped",
+                          in.delta, in.stamp, limit));
+    return;
+  }
+  if (in.valid && in.stamp < newest_rudder_stamp_) {
+    ++problems_.reordered;
+    problems_.example(InputProblems::kOrder, fmt("rudder t=%.3f s arrived after t=%.3f s", in.stamp,
+                                                 newest_rudder_stamp_));
+  }
+  if (in.valid) newest_rudder_stamp_ = std::max(newest_rudder_stamp_, in.stamp);
+  assembler_.add_rudder(in);
+}
 
 void FdiPipeline::process(const Sample& s) {
   std::vector<Detection> dets;
+  const double prev_t = last_t_;
   const bool ok = iso_.update(s, &dets);
   for (const Detection& d : dets) {
+    recheck_[index_of(d.sensor)].pending = false;  // the detector has taken the instance over
     FaultEvent ev;
-    if (latches_[static_cast<int>(d.sensor)].on_detection(d, iso_estimate_.A, &ev)) emit(ev);
+    if (latches_[index_of(d.sensor)].on_detection(d, iso_estimate_.A, &ev)) emit(ev);
   }
   if (!ok) {
     ++rejected_;
+    problems_.example(
+        InputProblems::kStamp,
+        fmt("INS sample t=%.3f s rejected: not after the previous one (t=%.3f s)", s.t, prev_t));
     return;
+  }
+  const IsolationParams& p = cfg_.isolation;
+  if (std::isfinite(prev_t) && s.t - prev_t > p.stale_timeout) {
+    problems_.example(InputProblems::kGap, fmt("no INS sample between t=%.3f and t=%.3f s (%.3f s)",
+                                               prev_t, s.t, s.t - prev_t));
+  }
+  if (std::isinf(s.v) || std::abs(s.v) > p.max_abs_v) {
+    problems_.example(InputProblems::kValue,
+                      fmt("v = %g m/s at t=%.3f s (|v| > max_abs_v %g)", s.v, s.t, p.max_abs_v));
+  }
+  if (std::isinf(s.r) || std::abs(s.r) > p.max_abs_r) {
+    problems_.example(InputProblems::kValue,
+                      fmt("r = %g rad/s at t=%.3f s (|r| > max_abs_r %g)", s.r, s.t, p.max_abs_r));
   }
   ++samples_;
   last_t_ = s.t;
+  // The rudder pauses identification and isolation: say so when it starts and ends.
+  const InputHealth& in = iso_.status().input;
+  if (!in.delta_ok && !rudder_paused_) {
+    rudder_paused_ = true;
+    log(2, newest_rudder_stamp_ > -1e299
+               ? fmt("rudder: no usable rudder angle since t=%.3f s (the last rudder sample, "
+                     "%.2f s before t=%.3f s): identification and isolation paused until "
+                     "rudder samples arrive",
+                     newest_rudder_stamp_, s.t - newest_rudder_stamp_, s.t)
+               : fmt("rudder: no usable rudder angle since the first INS sample (t=%.3f s): "
+                     "identification and isolation paused until rudder samples arrive",
+                     s.t));
+  } else if (in.delta_ok && rudder_paused_) {
+    rudder_paused_ = false;
+    log(1,
+        fmt("rudder: rudder angles again at t=%.3f s: identification and isolation resume", s.t));
+  }
+  recheck_restored(s);
   if (opt_.lockstep) {
     std::unique_lock<std::mutex> lock(step_m_);
     ++ident_pushed_;
@@ -148,6 +316,48 @@ void FdiPipeline::process(const Sample& s) {
   if (updated) iso_.set_estimate(iso_estimate_);
 }
 
+void FdiPipeline::recheck_restored(const Sample& s) {
+  const IsolatorStatus& st = iso_.status();
+  for (int i = 0; i < 3; ++i) {
+    Recheck& rc = recheck_[i];
+    if (!rc.pending) continue;
+    bool absent = false;
+    std::string why;
+    if (sensor_level(rc.kind)) {
+      // Stale, stuck, invalid: the sensor checks run from the first sample.
+      absent = i == 0 ? st.input.v_ok : (i == 1 ? st.input.r_ok : true);
+      why = "its channel has been healthy for";
+    } else {
+      // A residual fault: only a re-armed detector that has learned can tell.
+      absent = st.armed && !st.learning && !st.settling && st.observer_problem.empty() &&
+               st.input.delta_ok;
+      why = "the re-armed detector has seen no fault for";
+    }
+    if (!absent) {
+      rc.ok_since = kNaN;
+      continue;
+    }
+    if (std::isnan(rc.ok_since)) rc.ok_since = s.t;
+    if (s.t - rc.ok_since < opt_.restore_recheck) continue;
+    rc.pending = false;
+    Detection d;
+    d.sensor = static_cast<Sensor>(i);
+    d.active = false;
+    d.kind = rc.kind;
+    d.detection_time = s.t;
+    d.statistic = i < 2 ? st.J(i) : st.J.maxCoeff();
+    d.threshold = i < 2 ? st.thresholds(i) : st.threshold;
+    d.message = "not present after the restart: " + why + fmt(" %.1f s", opt_.restore_recheck);
+    FaultEvent ev;
+    if (latches_[i].on_detection(d, iso_estimate_.A, &ev)) {
+      log(1, std::string("restored ") + to_string(d.sensor) + " fault (" + to_string(rc.kind) +
+                 ") " + d.message + ": now #" + std::to_string(ev.sequence) + " " +
+                 to_string(ev.state));
+      emit(ev);
+    }
+  }
+}
+
 void FdiPipeline::handle_ack(const AckInput& a) {
   FaultEvent ev;
   if (!opt_.authorised_operators.empty() &&
@@ -163,7 +373,9 @@ void FdiPipeline::handle_ack(const AckInput& a) {
   }
   FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
   const std::uint64_t current = latch.current().sequence;
-  const AckResult r = latch.acknowledge(a.sequence, last_t_, a.who, &ev);
+  // Stamp: the time of the last sample (before any sample after a restart: the event's own).
+  const double t = std::isfinite(last_t_) ? last_t_ : latch.current().t;
+  const AckResult r = latch.acknowledge(a.sequence, t, a.who, &ev);
   if (r == AckResult::kAccepted) {
     log(1, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
                " by " + a.who + " accepted");
@@ -175,7 +387,7 @@ void FdiPipeline::handle_ack(const AckInput& a) {
   }
 }
 
-PipelineStatus FdiPipeline::make_status() const {
+PipelineStatus FdiPipeline::make_status() {
   PipelineStatus st;
   st.stamp = last_t_;
   st.estimate = iso_estimate_;
@@ -185,9 +397,101 @@ PipelineStatus FdiPipeline::make_status() const {
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
   st.dropped_output = output_.dropped() + dropped_at_stop_.load();
-  st.ins_silent = ins_silent_.load();
-  st.rudder_missing = !st.isolation.input.delta_ok;
+  const InputHealth& in = st.isolation.input;
+  const double since_start =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count();
+  // An INS that has not published since start is as silent as one that stopped.
+  st.ins_silent = ins_silent_.load() || (!had_ins_ && since_start > opt_.input_timeout);
+  st.rudder_missing = !in.delta_ok;
+  st.rejected_timestamps = in.rejected_time + problems_.bad_stamps;
+  st.invalid_values = in.invalid_values + problems_.invalid;
+  st.gaps = in.gaps;
+  st.reordered = problems_.reordered;
+  std::uint32_t f = 0;
+  if (st.ins_silent) f |= kInputInsSilent;
+  if (!in.delta_ok) f |= kInputRudderMissing;
+  if (!in.v_ok) f |= kInputAccelUnusable;
+  if (!in.r_ok) f |= kInputGyroUnusable;
+  if (st.rejected_timestamps > logged_.rejected_timestamps) f |= kInputBadTimestamps;
+  if (st.invalid_values > logged_.invalid_values) f |= kInputInvalidValues;
+  if (st.gaps > logged_.gaps) f |= kInputGaps;
+  if (st.reordered > logged_.reordered) f |= kInputReordered;
+  if (st.dropped_inputs > logged_.dropped_inputs) f |= kInputQueueDrops;
+  st.input_flags = f;
+  // Why identification and isolation do not run.
+  std::uint32_t id = 0, iso = 0;
+  if (st.ins_silent || st.samples == 0) {
+    id |= kPauseInsSilent;
+    iso |= kPauseInsSilent;
+  }
+  if (iso_.freeze_requested()) {
+    if (!in.delta_ok) id |= kPauseRudderMissing;
+    if (!in.v_ok || !in.r_ok) id |= kPauseInsUnusable;
+    if (!(id & (kPauseRudderMissing | kPauseInsUnusable))) id |= kPauseFault;
+  }
+  if (!st.isolation.armed) {
+    iso |= kPauseNotArmed;
+  } else if (st.isolation.learning || st.isolation.settling) {
+    iso |= kPauseLearning;
+  }
+  if (!in.delta_ok) iso |= kPauseRudderMissing;
+  if (!st.isolation.observer_problem.empty()) iso |= kPauseObserver;
+  st.identification_paused = id;
+  st.isolation_paused = iso;
   return st;
+}
+
+std::string FdiPipeline::InputProblems::examples_of(Kind k) {
+  std::string out;
+  for (const std::string& e : examples[k]) out += (out.empty() ? "" : "; ") + e;
+  examples[k].clear();
+  return out;
+}
+
+void FdiPipeline::log_input_changes(const PipelineStatus& st) {
+  const auto more = [](std::uint64_t now, std::uint64_t before) {
+    return std::to_string(now - before);
+  };
+  if (st.rejected_timestamps > logged_.rejected_timestamps) {
+    log(2, "inputs: " + more(st.rejected_timestamps, logged_.rejected_timestamps) +
+               " sample(s) with a repeated, backward or non-finite timestamp dropped (" +
+               std::to_string(st.rejected_timestamps) + " since start), e.g. " +
+               problems_.examples_of(InputProblems::kStamp));
+  }
+  if (st.invalid_values > logged_.invalid_values) {
+    log(2, "inputs: " + more(st.invalid_values, logged_.invalid_values) +
+               " invalid value(s): NaN flagged valid, infinite or absurd (" +
+               std::to_string(st.invalid_values) + " since start), e.g. " +
+               problems_.examples_of(InputProblems::kValue));
+  }
+  if (st.gaps > logged_.gaps) {
+    log(2, "inputs: " + more(st.gaps, logged_.gaps) + " gap(s) longer than stale_timeout " +
+               fmt("%g s", cfg_.isolation.stale_timeout) + " (" + std::to_string(st.gaps) +
+               " since start), e.g. " + problems_.examples_of(InputProblems::kGap));
+  }
+  if (st.reordered > logged_.reordered) {
+    log(1, "inputs: " + more(st.reordered, logged_.reordered) +
+               " sample(s) delivered out of order (re-sorted within rudder_wait, later ones "
+               "rejected), e.g. " +
+               problems_.examples_of(InputProblems::kOrder));
+  }
+  if (st.dropped_inputs > logged_.dropped_inputs) {
+    log(2, "inputs: input queue full (" + std::to_string(input_.capacity()) +
+               "): " + more(st.dropped_inputs, logged_.dropped_inputs) +
+               " sample(s) dropped, oldest first (" + std::to_string(st.dropped_inputs) +
+               " since start): samples arrive faster than the isolation thread processes them");
+  }
+  if (st.ins_silent && !had_ins_ && !never_ins_logged_) {
+    never_ins_logged_ = true;
+    log(2,
+        fmt("no INS sample since start (%.1f s): detection is not running",
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count()));
+  }
+  logged_.rejected_timestamps = st.rejected_timestamps;
+  logged_.invalid_values = st.invalid_values;
+  logged_.gaps = st.gaps;
+  logged_.reordered = st.reordered;
+  logged_.dropped_inputs = st.dropped_inputs;
 }
 
 PipelineStatus FdiPipeline::status() const {
@@ -203,27 +507,44 @@ PipelineStatus FdiPipeline::status() const {
   return st;
 }
 
+PipelineLiveness FdiPipeline::liveness() const {
+  PipelineLiveness l;
+  if (!started_) return l;
+  const std::int64_t now = now_ns();
+  const auto age = [now](const std::atomic<std::int64_t>& t) {
+    return static_cast<double>(now - t.load(std::memory_order_relaxed)) * 1e-9;
+  };
+  if (!stopped_) {
+    l.isolation = age(beat_iso_);
+    l.identification = age(beat_ident_);
+    l.publisher = age(beat_pub_);
+  }
+  if (last_ins_ns_.load(std::memory_order_relaxed) != 0) l.ins_age = age(last_ins_ns_);
+  if (last_rudder_ns_.load(std::memory_order_relaxed) != 0) l.rudder_age = age(last_rudder_ns_);
+  return l;
+}
+
 void FdiPipeline::isolation_loop() {
   using Clock = std::chrono::steady_clock;
   for (const FaultEvent& ev : restored_) emit(ev);
   auto last_status = Clock::now();
   auto last_ins = Clock::now();
-  bool had_ins = false;
   std::vector<Sample> batch;
   const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
   for (;;) {
+    beat_iso_.store(now_ns(), std::memory_order_relaxed);
     Input in;
     const auto r = input_.pop_for(&in, std::chrono::milliseconds(50));
     if (r == BoundedQueue<Input>::PopResult::kShutdown) break;
     const auto now = Clock::now();
     if (r == BoundedQueue<Input>::PopResult::kValue) {
       if (const auto* ins = std::get_if<InsInput>(&in)) {
-        assembler_.add_ins(*ins);
+        accept_ins(*ins);
         last_ins = now;
-        had_ins = true;
+        had_ins_ = true;
         if (ins_silent_.exchange(false)) log(1, "INS samples arrive again");
       } else if (const auto* rud = std::get_if<RudderInput>(&in)) {
-        assembler_.add_rudder(*rud);
+        accept_rudder(*rud);
       } else {
         handle_ack(std::get<AckInput>(in));
       }
@@ -231,9 +552,10 @@ void FdiPipeline::isolation_loop() {
       assembler_.drain(&batch);
       for (const Sample& s : batch) process(s);
     }
-    if (had_ins && !ins_silent_ && seconds(now - last_ins) > opt_.input_timeout) {
+    if (had_ins_ && !ins_silent_ && seconds(now - last_ins) > opt_.input_timeout) {
       ins_silent_ = true;
-      log(2, "no INS sample for " + std::to_string(seconds(now - last_ins)) + " s");
+      log(2, fmt("no INS sample for %.2f s (input_timeout %g s): both INS channels stale",
+                 seconds(now - last_ins), opt_.input_timeout));
       batch.clear();
       assembler_.drain(&batch, true);
       for (const Sample& s : batch) process(s);
@@ -244,6 +566,7 @@ void FdiPipeline::isolation_loop() {
     if (seconds(now - last_status) >= opt_.status_period) {
       last_status = now;
       const PipelineStatus st = make_status();
+      log_input_changes(st);
       {
         std::lock_guard<std::mutex> lock(snap_m_);
         last_status_ = st;
@@ -263,7 +586,11 @@ void FdiPipeline::identification_loop() {
   IdentItem it;
   double last_snapshot = -1e300;
   bool last_converged = false;
-  while (ident_q_.pop(&it)) {
+  for (;;) {
+    beat_ident_.store(now_ns(), std::memory_order_relaxed);
+    const auto r = ident_q_.pop_for(&it, std::chrono::milliseconds(100));
+    if (r == BoundedQueue<IdentItem>::PopResult::kShutdown) break;
+    if (r == BoundedQueue<IdentItem>::PopResult::kTimeout) continue;
     gate_.push(it.s, it.freeze);
     Sample old;
     bool freeze = false;
@@ -274,9 +601,21 @@ void FdiPipeline::identification_loop() {
     }
     const Estimate& e = ident_.estimate();
     if (updated && (e.t - last_snapshot >= opt_.snapshot_period || e.converged != last_converged)) {
-      std::lock_guard<std::mutex> lock(snap_m_);
-      snapshot_ = e;
-      ++snapshot_version_;
+      if (e.converged != last_converged) {
+        const Mat2& A = e.A;
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "identification: A %s at t=%.2f s: A = [%.4g %.4g; %.4g %.4g], "
+                      "excitation %.3g",
+                      e.converged ? "converged" : "no longer converged", e.t, A(0, 0), A(0, 1),
+                      A(1, 0), A(1, 1), e.excitation);
+        log(1, buf);
+      }
+      {
+        std::lock_guard<std::mutex> lock(snap_m_);
+        snapshot_ = e;
+        ++snapshot_version_;
+      }
       last_snapshot = e.t;
       last_converged = e.converged;
     }
@@ -290,24 +629,60 @@ void FdiPipeline::identification_loop() {
   }
 }
 
+void FdiPipeline::publish(const FaultEvent& ev) {
+  std::uint64_t& published = published_seq_[index_of(ev.sensor)];
+  if (ev.sequence <= published) return;  // already handed over (after an overflow)
+  published = ev.sequence;
+  try {
+    if (on_event_) on_event_(ev);
+  } catch (const std::exception& e) {
+    log(3, std::string("publishing failed: ") + e.what());
+  }
+}
+
+void FdiPipeline::publish_latest() {
+  std::array<FaultEvent, 3> latest;
+  {
+    std::lock_guard<std::mutex> lock(latest_m_);
+    latest = latest_;
+  }
+  for (const FaultEvent& ev : latest) {
+    if (ev.sequence <= published_seq_[index_of(ev.sensor)]) continue;
+    log(2, std::string("output queue overflowed: publishing the latest state of ") +
+               to_string(ev.sensor) + " (#" + std::to_string(ev.sequence) + " " +
+               to_string(ev.state) + "); intermediate states were dropped");
+    publish(ev);
+  }
+}
+
 void FdiPipeline::publisher_loop() {
   Output o;
-  while (output_.pop(&o)) {
-    const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                    std::chrono::steady_clock::now().time_since_epoch())
-                                    .count();
-    if (now_ns > drain_deadline_ns_.load()) {
-      ++dropped_at_stop_;  // stop() is waiting: never block shutdown on a slow writer
-      continue;
-    }
-    try {
-      if (const auto* ev = std::get_if<FaultEvent>(&o)) {
-        if (on_event_) on_event_(*ev);
-      } else if (on_status_) {
-        on_status_(std::get<PipelineStatus>(o));
+  std::uint64_t seen_drops = 0;
+  for (;;) {
+    beat_pub_.store(now_ns(), std::memory_order_relaxed);
+    const auto r = output_.pop_for(&o, std::chrono::milliseconds(100));
+    if (r == BoundedQueue<Output>::PopResult::kShutdown) break;
+    // stop() is waiting: never block shutdown on a slow writer.
+    const bool late = now_ns() > drain_deadline_ns_.load();
+    if (r == BoundedQueue<Output>::PopResult::kValue) {
+      if (late) {
+        ++dropped_at_stop_;
+        continue;
       }
-    } catch (const std::exception& e) {
-      log(3, std::string("publishing failed: ") + e.what());
+      if (const auto* ev = std::get_if<FaultEvent>(&o)) {
+        publish(*ev);
+      } else if (on_status_) {
+        try {
+          on_status_(std::get<PipelineStatus>(o));
+        } catch (const std::exception& e) {
+          log(3, std::string("publishing the status failed: ") + e.what());
+        }
+      }
+    }
+    const std::uint64_t drops = output_.dropped();
+    if (drops != seen_drops && !late) {
+      seen_drops = drops;
+      publish_latest();
     }
   }
   if (dropped_at_stop_.load() > 0) {

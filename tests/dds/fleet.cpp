@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -57,6 +58,22 @@ bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* even
       s.armed = v.at("armed").b;
       s.samples = static_cast<unsigned long long>(v.at("samples").num);
       s.dropped = static_cast<unsigned long long>(v.at("dropped").num);
+      const auto names = [&](const char* key) {
+        std::vector<std::string> out;
+        for (const js::Value& x : v.at(key).arr) out.push_back(x.str);
+        return out;
+      };
+      s.input_flags = names("input_flags");
+      s.identification_paused = names("identification_paused");
+      s.isolation_paused = names("isolation_paused");
+      const auto count = [&](const char* key) {
+        return static_cast<unsigned long long>(v.at(key).num);
+      };
+      s.rejected_timestamps = count("rejected_timestamps");
+      s.invalid_values = count("invalid_values");
+      s.gaps = count("gaps");
+      s.reordered = count("reordered");
+      s.dropped_inputs = count("dropped_inputs");
       if (statuses != nullptr) statuses->push_back(s);
     }
   } catch (const std::exception& e) {
@@ -65,6 +82,12 @@ bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* even
   }
   return true;
 }
+
+bool MonitorStatus::has(const std::vector<std::string>& v, const std::string& f) {
+  return std::find(v.begin(), v.end(), f) != v.end();
+}
+
+bool MonitorStatus::has_flag(const std::string& f) const { return has(input_flags, f); }
 
 Fleet::Fleet() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
@@ -105,18 +128,43 @@ std::string Fleet::write_service_config(const std::string& name, unsigned mmsi,
   std::ofstream f(path);
   f << slurp(std::string(USV_FDI_SOURCE_DIR) + "/config/scenarios/paper.yaml");
   f << "\nservice:\n  mmsi: " << mmsi << "\n  reliable_inputs: true\n  status_rate: 5\n";
+  bool own_state = false;
+  for (const auto& line : extra) own_state |= line.rfind("state_dir:", 0) == 0;
+  // Each sidecar config gets a state directory of its own (never the host's default).
+  if (!own_state) f << "  state_dir: " << state_dir(name) << "\n";
   for (const auto& line : extra) f << "  " << line << "\n";
   if (!f) throw std::runtime_error("cannot write " + path);
   return path;
 }
 
 ChildProcess& Fleet::start(const std::string& name, std::vector<std::string> args,
-                           const std::vector<std::string>& extra_env) {
+                           const std::vector<std::string>& extra_env, bool dds) {
   std::vector<std::string> argv = {USV_FDI_EXE};
   argv.insert(argv.end(), args.begin(), args.end());
-  const auto d = dds_args();
-  argv.insert(argv.end(), d.begin(), d.end());
+  if (dds) {
+    const auto d = dds_args();
+    argv.insert(argv.end(), d.begin(), d.end());
+  }
   auto p = std::make_unique<ChildProcess>(argv, dir_ + name + ".log", extra_env);
+  ChildProcess& ref = *p;
+  procs_[name] = std::move(p);
+  return ref;
+}
+
+ChildProcess& Fleet::start_probe(const std::string& name, const std::string& mode,
+                                 std::vector<std::string> args) {
+  std::vector<std::string> argv = {kProbe,
+                                   mode,
+                                   "--profiles",
+                                   kProfilesFile,
+                                   "--domain",
+                                   domain_,
+                                   "--partition",
+                                   partition_,
+                                   "--participant-profile",
+                                   "usv_fdi_participant_loopback"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  auto p = std::make_unique<ChildProcess>(argv, dir_ + name + ".log");
   ChildProcess& ref = *p;
   procs_[name] = std::move(p);
   return ref;
@@ -149,8 +197,9 @@ ChildProcess& Fleet::start_service(const std::string& name, const std::string& c
 }
 
 std::optional<int> Fleet::run_to_end(const std::string& name, std::vector<std::string> args,
-                                     std::chrono::milliseconds timeout, std::string* out) {
-  ChildProcess& p = start(name, std::move(args));
+                                     std::chrono::milliseconds timeout, std::string* out,
+                                     bool dds) {
+  ChildProcess& p = start(name, std::move(args), {}, dds);
   const std::string text = p.read_all(timeout);
   if (out != nullptr) *out = text;
   return p.wait_exit(std::chrono::milliseconds(2000));

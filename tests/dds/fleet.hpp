@@ -29,6 +29,11 @@ struct MonitorStatus {
   double stamp = 0;
   bool converged = false, armed = false;
   unsigned long long samples = 0, dropped = 0;
+  std::vector<std::string> input_flags, identification_paused, isolation_paused;
+  unsigned long long rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
+                     dropped_inputs = 0;
+  bool has_flag(const std::string& f) const;
+  static bool has(const std::vector<std::string>& v, const std::string& f);
 };
 
 /// Parses monitor --json lines (others are ignored); returns false on a malformed JSON line.
@@ -47,13 +52,21 @@ class Fleet {
   std::vector<std::string> dds_args() const;
 
   /// Writes the paper scenario's engine config (config/scenarios/paper.yaml) with a service
-  /// section: mmsi, reliable_inputs, status_rate 5, and `extra` lines (indented 2 spaces).
+  /// section: mmsi, reliable_inputs, status_rate 5, state_dir <dir>/state_<name> (unless
+  /// `extra` sets it), and `extra` lines (indented 2 spaces).
   std::string write_service_config(const std::string& name, unsigned mmsi,
                                    const std::vector<std::string>& extra = {}) const;
 
-  /// Starts `usv-fdi <args> <dds_args>` with stderr to <dir>/<name>.log.
+  /// The state directory write_service_config() gives the sidecar of config `name`.
+  std::string state_dir(const std::string& name) const { return dir_ + "state_" + name; }
+
+  /// Starts `usv-fdi <args> <dds_args>` (without the DDS options if !dds) with stderr to
+  /// <dir>/<name>.log.
   ChildProcess& start(const std::string& name, std::vector<std::string> args,
-                      const std::vector<std::string>& extra_env = {});
+                      const std::vector<std::string>& extra_env = {}, bool dds = true);
+  /// Starts `usv_fdi_dds_probe <mode> <args>` on the fleet's domain and partition.
+  ChildProcess& start_probe(const std::string& name, const std::string& mode,
+                            std::vector<std::string> args);
   ChildProcess& process(const std::string& name) { return *procs_.at(name); }
   std::string log(const std::string& name) const;
   /// Waits until <name>.log contains `text`.
@@ -66,7 +79,8 @@ class Fleet {
                               int wait_monitors = 0, std::vector<std::string> extra_args = {});
   /// Runs a process to its end (bounded); returns its exit code (nullopt: still running).
   std::optional<int> run_to_end(const std::string& name, std::vector<std::string> args,
-                                std::chrono::milliseconds timeout, std::string* out = nullptr);
+                                std::chrono::milliseconds timeout, std::string* out = nullptr,
+                                bool dds = true);
 
  private:
   std::string dir_;

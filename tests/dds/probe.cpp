@@ -15,6 +15,24 @@
 //       instance mmsi=.. sensor=.. state=.. kind=.. sequence=.. samples=.. message=..
 //     and exits 0; exits 1 on timeout (after printing what it has).
 //
+//   usv_fdi_dds_probe publish-inputs --profiles FILE [DDS options] --mmsi M --script FILE
+//       [--timeout SECONDS]
+//     A scriptable INS/rudder source (RELIABLE writers) for bad-input tests. Waits until a
+//     reader matches both writers, runs the script, waits for the readers' acknowledgements,
+//     prints "published ins=N rudder=M" and exits 0. Script lines ('#' comments):
+//       ins STAMP V R [V_VALID R_VALID]     one INS sample (nan, inf allowed)
+//       rudder STAMP DELTA [VALID]          one rudder sample
+//       both T0 T1 DT PACE_MS               rudder + INS pairs for t in [T0, T1) step DT,
+//                                           PACE_MS wall-clock ms apart (0: as fast as possible)
+//       insonly T0 T1 DT PACE_MS            the same, INS only (a silent rudder)
+//       sleep MS
+//
+//   usv_fdi_dds_probe slow-reader --profiles FILE [DDS options] [--delay-ms D]
+//     The slowest subscriber there is: FaultEvent and FdiStatus readers RELIABLE,
+//     TRANSIENT_LOCAL, KEEP_ALL with room for 2 samples per instance, whose listener sleeps D ms
+//     (default 200) in Fast DDS's receive thread after every sample it takes. Prints "event mmsi=..
+//     sensor=.. sequence=.. state=.." per FaultEvent taken; runs until SIGTERM.
+//
 //   usv_fdi_dds_probe writer-qos --profiles FILE --writer-profile NAME
 //     Joins the domain as the service does (FASTRTPS_DEFAULT_PROFILES_FILE first, then FILE)
 //     and prints the data writer profile's QoS as
@@ -23,13 +41,17 @@
 // Exit code 3: usage error; 4: DDS error.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
@@ -38,6 +60,7 @@
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/core/status/StatusMask.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
 #include "usv_fdi/dds/dds_context.hpp"
 
@@ -66,6 +89,9 @@ struct Options {
   unsigned expect = 0;
   unsigned settle_ms = 300;
   std::string writer_profile;
+  std::uint32_t mmsi = 0;
+  std::string script;
+  unsigned delay_ms = 200;
 };
 
 struct UsageError : std::runtime_error {
@@ -84,10 +110,14 @@ unsigned long parse_unsigned(const std::string& flag, const std::string& value) 
 }
 
 Options parse(int argc, char** argv) {
-  if (argc < 2) throw UsageError("missing mode (publish-faults | read-faults | writer-qos)");
+  if (argc < 2) {
+    throw UsageError(
+        "missing mode (publish-faults | read-faults | writer-qos | publish-inputs | slow-reader)");
+  }
   Options o;
   o.mode = argv[1];
-  if (o.mode != "publish-faults" && o.mode != "read-faults" && o.mode != "writer-qos") {
+  if (o.mode != "publish-faults" && o.mode != "read-faults" && o.mode != "writer-qos" &&
+      o.mode != "publish-inputs" && o.mode != "slow-reader") {
     throw UsageError("unknown mode '" + o.mode + "'");
   }
   for (int i = 2; i < argc; ++i) {
@@ -126,6 +156,12 @@ Options parse(int argc, char** argv) {
       o.writer_profile = value;
     } else if (flag == "--settle-ms") {
       o.settle_ms = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--mmsi") {
+      o.mmsi = static_cast<std::uint32_t>(parse_unsigned(flag, value));
+    } else if (flag == "--script") {
+      o.script = value;
+    } else if (flag == "--delay-ms") {
+      o.delay_ms = static_cast<unsigned>(parse_unsigned(flag, value));
     } else {
       throw UsageError("unknown option '" + flag + "'");
     }
@@ -249,6 +285,161 @@ int read_faults(const Options& o) {
   return 0;
 }
 
+double number(const std::string& text, const std::string& where) {
+  char* end = nullptr;
+  const double x = std::strtod(text.c_str(), &end);  // accepts nan, inf
+  if (end == text.c_str() || *end != '\0') throw UsageError(where + ": not a number: " + text);
+  return x;
+}
+
+int publish_inputs(const Options& o) {
+  if (o.mmsi == 0 || o.script.empty()) throw UsageError("--mmsi and --script are required");
+  std::ifstream in(o.script);
+  if (!in) throw UsageError("cannot read --script " + o.script);
+  std::vector<std::vector<std::string>> lines;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream ls(line);
+    std::vector<std::string> words;
+    for (std::string w; ls >> w;) words.push_back(w);
+    if (!words.empty() && words[0][0] != '#') lines.push_back(words);
+  }
+  install_signal_handlers();
+  const auto deadline = deadline_after(o.timeout_s);
+  DdsContext ctx(o.dds);
+  fdds::DataWriter& ins = ctx.create_writer<fdi::InsSample>(profiles::kInsWriterReliable);
+  fdds::DataWriter& rudder = ctx.create_writer<fdi::RudderSample>(profiles::kRudderWriterReliable);
+  for (;;) {
+    fdds::PublicationMatchedStatus a, b;
+    ins.get_publication_matched_status(a);
+    rudder.get_publication_matched_status(b);
+    if (a.current_count > 0 && b.current_count > 0) break;
+    if (Clock::now() >= deadline || g_stop.load()) {
+      std::fprintf(stderr, "publish-inputs: no reader matched\n");
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the reader's side of the match
+  std::uint64_t n_ins = 0, n_rudder = 0;
+  const auto write_ins = [&](double t, double v, double r, bool vv, bool rv) {
+    fdi::InsSample s;
+    s.mmsi(o.mmsi);
+    s.seq(++n_ins);
+    s.stamp(t);
+    s.v(v);
+    s.r(r);
+    s.v_valid(vv);
+    s.r_valid(rv);
+    usv_fdi::dds::write(ins, s);
+  };
+  const auto write_rudder = [&](double t, double d, bool valid) {
+    fdi::RudderSample s;
+    s.mmsi(o.mmsi);
+    s.seq(++n_rudder);
+    s.stamp(t);
+    s.delta(d);
+    s.valid(valid);
+    usv_fdi::dds::write(rudder, s);
+  };
+  for (std::size_t i = 0; i < lines.size() && !g_stop.load(); ++i) {
+    const auto& w = lines[i];
+    const std::string where = o.script + ":" + std::to_string(i + 1);
+    const auto arg = [&](std::size_t k) {
+      if (k >= w.size()) throw UsageError(where + ": missing argument " + std::to_string(k));
+      return number(w[k], where);
+    };
+    if (w[0] == "ins") {
+      write_ins(arg(1), arg(2), arg(3), w.size() > 4 ? arg(4) != 0 : true,
+                w.size() > 5 ? arg(5) != 0 : true);
+    } else if (w[0] == "rudder") {
+      write_rudder(arg(1), arg(2), w.size() > 3 ? arg(3) != 0 : true);
+    } else if (w[0] == "both" || w[0] == "insonly") {
+      const double t0 = arg(1), t1 = arg(2), dt = arg(3), pace = arg(4);
+      for (int k = 0; !g_stop.load(); ++k) {
+        const double t = t0 + dt * k;
+        if (t >= t1 - 1e-9) break;
+        if (w[0] == "both") write_rudder(t, 0.1 * std::sin(0.5 * t), true);
+        write_ins(t, 0.01 * std::sin(0.7 * t) + 0.001 * std::sin(13 * t),
+                  0.002 * std::cos(0.3 * t) + 0.0002 * std::cos(11 * t), true, true);
+        if (pace > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(pace));
+      }
+    } else if (w[0] == "sleep") {
+      std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(arg(1)));
+    } else {
+      throw UsageError(where + ": unknown command '" + w[0] + "'");
+    }
+  }
+  // Every sample acknowledged by the readers before the writers go away.
+  ins.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+  rudder.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+  std::printf("published ins=%llu rudder=%llu\n", static_cast<unsigned long long>(n_ins),
+              static_cast<unsigned long long>(n_rudder));
+  std::fflush(stdout);
+  return 0;
+}
+
+/// Takes every available sample, sleeping after each one in Fast DDS's receive thread.
+class SlowListener : public fdds::DataReaderListener {
+ public:
+  explicit SlowListener(unsigned delay_ms) : delay_ms_(delay_ms) {}
+  void on_data_available(fdds::DataReader* reader) override {
+    using eprosima::fastrtps::types::ReturnCode_t;
+    const bool events =
+        reader->get_topicdescription()->get_type_name() == fdi::FaultEventPubSubType().getName();
+    fdds::SampleInfo info;
+    for (;;) {
+      if (g_stop.load()) return;
+      if (events) {
+        fdi::FaultEvent e;
+        if (reader->take_next_sample(&e, &info) != ReturnCode_t::RETCODE_OK) return;
+        if (info.valid_data) {
+          std::printf("event mmsi=%u sensor=%u sequence=%llu state=%u\n", e.mmsi(),
+                      static_cast<unsigned>(e.sensor()),
+                      static_cast<unsigned long long>(e.sequence()),
+                      static_cast<unsigned>(e.state()));
+          std::fflush(stdout);
+        }
+      } else {
+        fdi::FdiStatus st;
+        if (reader->take_next_sample(&st, &info) != ReturnCode_t::RETCODE_OK) return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms_));
+    }
+  }
+
+ private:
+  unsigned delay_ms_;
+};
+
+int slow_reader(const Options& o) {
+  install_signal_handlers();
+  DdsContext ctx(o.dds);
+  SlowListener listener(o.delay_ms);
+  fdds::DataReaderQos q = ctx.subscriber().get_default_datareader_qos();
+  q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  q.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+  // Room for 2 samples per instance (Fast DDS needs max_samples >= instances x per instance).
+  q.resource_limits().max_samples = 8;
+  q.resource_limits().max_instances = 4;
+  q.resource_limits().max_samples_per_instance = 2;
+  q.resource_limits().allocated_samples = 8;
+  fdds::DataReader* events = ctx.subscriber().create_datareader(
+      &ctx.topic(usv_fdi::dds::TopicId::kFaultEvent), q, &listener);
+  fdds::DataReader* status =
+      ctx.subscriber().create_datareader(&ctx.topic(usv_fdi::dds::TopicId::kStatus), q, &listener);
+  if (events == nullptr || status == nullptr) {
+    std::fprintf(stderr, "slow-reader: cannot create the readers\n");
+    return 4;
+  }
+  std::printf("slow reader ready\n");
+  std::fflush(stdout);
+  while (!g_stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  (void)ctx.subscriber().delete_datareader(events);
+  (void)ctx.subscriber().delete_datareader(status);
+  return 0;
+}
+
 int writer_qos(const Options& o) {
   if (o.writer_profile.empty()) throw UsageError("--writer-profile is required");
   DdsContext ctx(o.dds);  // loads the profiles exactly as the service does
@@ -270,6 +461,8 @@ int main(int argc, char** argv) {
   try {
     const Options o = parse(argc, argv);
     if (o.mode == "writer-qos") return writer_qos(o);
+    if (o.mode == "publish-inputs") return publish_inputs(o);
+    if (o.mode == "slow-reader") return slow_reader(o);
     return o.mode == "publish-faults" ? publish_faults(o) : read_faults(o);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "usv_fdi_dds_probe: %s\n", e.what());

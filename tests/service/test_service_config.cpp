@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -37,6 +38,11 @@ TEST(ServiceConfig, ShippedExampleLoadsWithItsDocumentedValues) {
   // qos_profiles is relative to the config file.
   EXPECT_EQ(c.dds.profiles_file, kSource + "/config/qos/usv_fdi_profiles.xml");
   EXPECT_DOUBLE_EQ(c.engine.B(0), 0.165394);
+  // Latched faults are kept in the default state directory (if it exists); no health file.
+  EXPECT_EQ(c.state_dir, "/var/lib/usv-fdi");
+  EXPECT_FALSE(c.state_dir_explicit);
+  EXPECT_EQ(c.health_file, "");
+  EXPECT_DOUBLE_EQ(c.pipeline.restore_recheck, 5.0);
 }
 
 TEST(ServiceConfig, EveryServiceKeyIsApplied) {
@@ -56,6 +62,9 @@ service:
   rudder_wait: 0.2
   rudder_timeout: 0.7
   input_timeout: 3
+  restore_recheck: 8
+  state_dir: state
+  health_file: /run/usv-fdi/health.json
 )");
   const ServiceConfig c = load_service_config(path);
   EXPECT_EQ(c.mmsi, 123456789u);
@@ -76,7 +85,19 @@ service:
   EXPECT_DOUBLE_EQ(c.pipeline.rudder_wait, 0.2);
   EXPECT_DOUBLE_EQ(c.pipeline.rudder_timeout, 0.7);
   EXPECT_DOUBLE_EQ(c.pipeline.input_timeout, 3.0);
+  EXPECT_DOUBLE_EQ(c.pipeline.restore_recheck, 8.0);
+  // Relative to the config file.
+  EXPECT_EQ(c.state_dir, (std::filesystem::path(path).parent_path() / "state").string());
+  EXPECT_TRUE(c.state_dir_explicit);
+  EXPECT_EQ(c.health_file, "/run/usv-fdi/health.json");
   std::remove(path.c_str());
+  // An empty state_dir switches persistence off.
+  const std::string off =
+      write_temp("off", "model:\n  B: [0.1, -2.0]\nservice:\n  state_dir: \"\"\n");
+  const ServiceConfig o = load_service_config(off);
+  EXPECT_EQ(o.state_dir, "");
+  EXPECT_TRUE(o.state_dir_explicit);
+  std::remove(off.c_str());
 }
 
 TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
@@ -98,6 +119,13 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
       {"  reliable_inputs: maybe", "4: service.reliable_inputs = maybe: must be true or false"},
       {"  qos_profiles: missing.xml", "4: service.qos_profiles = missing.xml: no such file"},
       {"  mmsi: 1\n  colour: red", "5: service.colour = colour: unknown key"},
+      {"  input_timeout: 0.2",
+       "4: service.input_timeout = 0.2: must be at least isolation.stale_timeout (0.5 s)"},
+      {"  restore_recheck: 0", "4: service.restore_recheck = 0: must be a positive time"},
+      {"  state_dir: [a]", "4: service.state_dir = <list>: must be a directory"},
+      {"  state_dir: " + kSource + "/README.md",
+       "4: service.state_dir = " + kSource + "/README.md: not a directory"},
+      {"  health_file: {a: 1}", "4: service.health_file = <mapping>: must be a file path"},
   };
   for (const Case& c : cases) {
     const std::string path =

@@ -4,10 +4,14 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "usv_fdi/core/simulator.hpp"
+#include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/service/pipeline.hpp"
 
 namespace usvfdi {
@@ -77,6 +81,19 @@ TEST(SampleAssembler, HoldsThenDropsALateRudder) {
   ASSERT_FALSE(out.empty());
   EXPECT_DOUBLE_EQ(out.front().delta, 0.2);   // held
   EXPECT_TRUE(std::isnan(out.back().delta));  // older than rudder_timeout: missing
+}
+
+TEST(SampleAssembler, DoesNotBridgeARudderGapLongerThanTheTimeout) {
+  SampleAssembler a(0.1, 0.5);
+  a.add_rudder({0.0, 0.0, true});
+  a.add_rudder({3.0, 0.3, true});
+  for (double t : {0.2, 1.5, 2.9}) a.add_ins({t, 0.0, 0.0, true, true});
+  std::vector<Sample> out;
+  a.drain(&out);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_DOUBLE_EQ(out[0].delta, 0.0);    // held from the sample 0.2 s before
+  EXPECT_TRUE(std::isnan(out[1].delta));  // 1.5 s from either side: no rudder angle
+  EXPECT_DOUBLE_EQ(out[2].delta, 0.3);    // held from the sample 0.1 s after
 }
 
 struct Collected {
@@ -247,6 +264,423 @@ TEST(FdiPipeline, StopReturnsPromptlyUnderLoadAndCountsDrops) {
   // THEN every thread joined well within 2 s, and overflow was counted, not hidden
   EXPECT_LT(took, 2.0);
   EXPECT_GT(p.status().dropped_inputs + p.status().rejected, 0u);
+}
+
+// ---------------------------------------------------------------- bad input
+
+/// Waits (bounded) until some collected status satisfies pred; returns it.
+template <class Pred>
+bool wait_status(Collected* c, std::chrono::milliseconds timeout, Pred pred,
+                 PipelineStatus* found = nullptr) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    {
+      std::lock_guard<std::mutex> l(c->m);
+      for (const PipelineStatus& s : c->statuses) {
+        if (pred(s)) {
+          if (found != nullptr) *found = s;
+          return true;
+        }
+      }
+    }
+    if (std::chrono::steady_clock::now() >= end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+bool logged(Collected* c, const std::string& text) {
+  std::lock_guard<std::mutex> l(c->m);
+  for (const auto& s : c->logs) {
+    if (s.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+std::string all_logs(Collected* c) {
+  std::lock_guard<std::mutex> l(c->m);
+  std::string out;
+  for (const auto& s : c->logs) out += s + "\n";
+  return out;
+}
+
+EngineConfig otter() {
+  VesselModel v;
+  EXPECT_TRUE(find_vessel("otter", &v));
+  EngineConfig cfg;
+  cfg.B = v.B;
+  return cfg;
+}
+
+/// Healthy-looking samples (rudder first) for t in [t0, t1) at 50 Hz.
+void feed(FdiPipeline& p, double t0, double t1, bool rudder = true) {
+  for (int k = 0;; ++k) {
+    const double t = t0 + 0.02 * k;
+    if (t >= t1 - 1e-9) break;
+    if (rudder) p.push_rudder({t, 0.05 * std::sin(0.5 * t), true});
+    p.push_ins({t, 0.01 * std::sin(0.7 * t) + 0.001 * std::sin(13 * t),
+                0.002 * std::cos(0.3 * t) + 0.0002 * std::cos(11 * t), true, true});
+  }
+}
+
+TEST(FdiPipelineInputs, BadSamplesAreCountedFlaggedAndLoggedWithAnExample) {
+  // GIVEN a running pipeline
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  opt.input_timeout = 60.0;
+  FdiPipeline p = make(otter(), &c, opt);
+  p.start();
+  // WHEN it receives one second of good samples and then every kind of bad one
+  feed(p, 0.0, 1.0);
+  p.push_ins({kNaN, 0.0, 0.0, true, true});  // non-finite stamp
+  p.push_rudder({1.00, 0.0, true});
+  p.push_ins({1.00, kNaN, 0.001, true, true});  // NaN flagged valid
+  p.push_rudder({1.02, 0.0, true});
+  p.push_ins({1.02, 0.01, std::numeric_limits<double>::infinity(), true, true});  // Inf
+  p.push_rudder({1.04, 0.0, true});
+  p.push_ins({1.04, 1000.0, 0.001, true, true});                        // absurd magnitude
+  p.push_ins({1.04, 0.01, 0.001, true, true});                          // repeated stamp
+  p.push_ins({1.03, 0.01, 0.001, true, true});                          // backwards, out of order
+  p.push_rudder({1.05, kNaN, true});                                    // NaN rudder flagged valid
+  p.push_rudder({1.05, 5.0, true});                                     // absurd rudder angle
+  p.push_rudder({std::numeric_limits<double>::infinity(), 0.0, true});  // non-finite stamp
+  feed(p, 3.0, 4.0);                                                    // a gap of ~2 s
+  // THEN the status counts each kind, flags it for the period it happened in, and the log
+  // says what was wrong with an example
+  PipelineStatus st;
+  ASSERT_TRUE(wait_status(
+      &c, std::chrono::milliseconds(10000),
+      [](const PipelineStatus& s) {
+        return s.rejected_timestamps >= 4 && s.invalid_values >= 5 && s.gaps >= 1 &&
+               s.reordered >= 1 && s.samples >= 99;
+      },
+      &st))
+      << all_logs(&c);
+  EXPECT_EQ(st.rejected_timestamps, 4u);  // NaN INS stamp, Inf rudder stamp, repeat, backwards
+  EXPECT_EQ(st.invalid_values, 5u);       // v NaN, r Inf, v 1000, rudder NaN, rudder 5 rad
+  EXPECT_EQ(st.gaps, 1u);
+  EXPECT_EQ(st.reordered, 1u);
+  EXPECT_EQ(st.rejected, 2u);
+  const std::uint32_t want =
+      kInputBadTimestamps | kInputInvalidValues | kInputGaps | kInputReordered;
+  EXPECT_TRUE(wait_status(&c, std::chrono::milliseconds(1), [&](const PipelineStatus& s) {
+    return (s.input_flags & want) == want;
+  })) << "no status flagged the period of the bad samples";
+  // The per-period flags clear once a period passes without new problems.
+  EXPECT_TRUE(wait_status(&c, std::chrono::milliseconds(5000), [&](const PipelineStatus& s) {
+    return s.samples == st.samples && (s.input_flags & want) == 0;
+  }));
+  for (const char* text :
+       {"with a repeated, backward or non-finite timestamp dropped",
+        "an INS sample with stamp nan was dropped", "rejected: not after the previous one",
+        "invalid value(s)", "v = NaN flagged valid at t=1.000 s (used as missing)",
+        "r = inf rad/s at t=1.020 s", "v = 1000 m/s at t=1.040 s (|v| > max_abs_v 20)",
+        "gap(s) longer than stale_timeout 0.5 s", "no INS sample between t=",
+        "delivered out of order", "INS t=1.030 s arrived after t=1.040 s"}) {
+    EXPECT_TRUE(logged(&c, text)) << text << "\n" << all_logs(&c);
+  }
+  p.stop();
+}
+
+TEST(FdiPipelineInputs, UnusableRudderSamplesAreDroppedWithTheirValue) {
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  FdiPipeline p = make(otter(), &c, opt);
+  p.start();
+  p.push_rudder({0.0, 5.0, true});
+  p.push_rudder({std::numeric_limits<double>::infinity(), 0.0, true});
+  p.push_rudder({0.1, 0.0, false});  // flagged invalid: simply missing, not a problem
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(5000), [](const PipelineStatus& s) {
+    return s.invalid_values == 1 && s.rejected_timestamps == 1;
+  }));
+  p.stop();
+  EXPECT_TRUE(logged(&c, "rudder angle 5 rad at t=0.000 s (|delta| > max_abs_delta 1.6) dropped"))
+      << all_logs(&c);
+  EXPECT_TRUE(logged(&c, "a rudder sample with stamp inf was dropped")) << all_logs(&c);
+}
+
+TEST(FdiPipelineInputs, SilentRudderPausesIdentificationAndIsolationAndSaysSo) {
+  // GIVEN a pipeline receiving INS and rudder samples
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  opt.input_timeout = 60.0;
+  FdiPipeline p = make(otter(), &c, opt);
+  p.start();
+  feed(p, 0.0, 2.0);
+  // WHEN the rudder stream goes silent while the INS keeps publishing
+  feed(p, 2.0, 5.0, false);
+  // THEN the status flags the missing rudder and both threads as paused for it, and the log
+  // says so once
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(10000), [](const PipelineStatus& s) {
+    return (s.input_flags & kInputRudderMissing) &&
+           (s.identification_paused & kPauseRudderMissing) &&
+           (s.isolation_paused & kPauseRudderMissing) && s.rudder_missing;
+  })) << all_logs(&c);
+  EXPECT_TRUE(logged(&c, "rudder: no usable rudder angle since t=1.980 s (the last rudder sample"))
+      << all_logs(&c);
+  EXPECT_TRUE(logged(&c, "identification and isolation paused until rudder samples arrive"));
+  // WHEN rudder samples arrive again THEN the pause ends, and the log says so
+  feed(p, 5.0, 7.0);
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(10000), [](const PipelineStatus& s) {
+    return s.samples >= 340 && !(s.input_flags & kInputRudderMissing) &&
+           !(s.identification_paused & kPauseRudderMissing) &&
+           !(s.isolation_paused & kPauseRudderMissing);
+  })) << all_logs(&c);
+  EXPECT_TRUE(logged(&c, "identification and isolation resume")) << all_logs(&c);
+  p.stop();
+  std::lock_guard<std::mutex> l(c.m);
+  int pauses = 0;
+  for (const auto& s : c.logs) pauses += s.find("paused until rudder") != std::string::npos;
+  EXPECT_EQ(pauses, 1) << "logged once, not per sample";
+}
+
+TEST(FdiPipelineInputs, SilentInsIsFlaggedFromStartAndRaisesStaleWhenItStops) {
+  // GIVEN a pipeline that has never received an INS sample
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  opt.input_timeout = 0.6;  // >= isolation.stale_timeout (0.5 s): the silence is stale
+  FdiPipeline p = make(otter(), &c, opt);
+  p.start();
+  // THEN after input_timeout the status says the INS is silent and nothing runs
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(5000), [](const PipelineStatus& s) {
+    return (s.input_flags & kInputInsSilent) && (s.identification_paused & kPauseInsSilent) &&
+           (s.isolation_paused & kPauseInsSilent);
+  }));
+  // (the log line comes with the status that first flags it)
+  EXPECT_TRUE(logged(&c, "no INS sample since start")) << all_logs(&c);
+  // WHEN samples arrive the flag clears; WHEN they stop again both channels go stale
+  {
+    std::lock_guard<std::mutex> l(c.m);
+    c.statuses.clear();
+  }
+  feed(p, 0.0, 1.0);
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(5000), [](const PipelineStatus& s) {
+    return s.samples > 0 && !(s.input_flags & kInputInsSilent);
+  }));
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(5000), [](const PipelineStatus& s) {
+    return (s.input_flags & kInputInsSilent) != 0;
+  }));
+  p.stop();
+  EXPECT_TRUE(logged(&c, "(input_timeout 0.6 s): both INS channels stale")) << all_logs(&c);
+  int stale = 0;
+  for (const FaultEvent& e : c.events) {
+    stale += e.kind == FaultKind::kStale && e.state == FaultState::kRaised;
+  }
+  EXPECT_EQ(stale, 2);
+}
+
+TEST(FdiPipelineInputs, ABurstLargerThanTheQueueDropsTheOldestAndSaysSo) {
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  opt.input_capacity = 64;
+  opt.input_timeout = 60.0;
+  FdiPipeline p = make(otter(), &c, opt);
+  p.start();
+  feed(p, 0.0, 100.0);  // 10000 inputs as fast as the test can push them
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(10000), [](const PipelineStatus& s) {
+    return (s.input_flags & kInputQueueDrops) && s.dropped_inputs > 0;
+  }));
+  p.stop();
+  const PipelineStatus st = p.status();
+  EXPECT_GT(st.dropped_inputs, 0u);
+  EXPECT_EQ(st.samples + st.dropped_inputs / 2 + 64, st.samples + st.dropped_inputs / 2 + 64);
+  EXPECT_TRUE(logged(&c, "input queue full (64)")) << all_logs(&c);
+  EXPECT_TRUE(logged(&c, "sample(s) dropped, oldest first")) << all_logs(&c);
+}
+
+// ---------------------------------------------------------------- restart
+
+TEST(FdiPipelineRestore, RestoredFaultsArePublishedWithTheirSequenceAckedAndRechecked) {
+  // GIVEN latched faults restored from a previous run: a stale gyro fault (raised, #3), a
+  // residual accelerometer fault (raised, #2), an unknown-sensor one awaiting its ack (#1)
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  opt.input_timeout = 60.0;
+  opt.restore_recheck = 1.0;
+  FdiPipeline p = make(otter(), &c, opt);
+  auto restored = [](Sensor s, FaultState st, FaultKind k, std::uint64_t seq) {
+    FaultEvent e;
+    e.sensor = s;
+    e.state = st;
+    e.kind = k;
+    e.sequence = seq;
+    e.detection_time = e.onset_time = e.t = 20.0;
+    e.c_g = s == Sensor::kGyro ? 1.0 : 0.0;
+    e.message = "before the restart";
+    return e;
+  };
+  p.restore(restored(Sensor::kGyro, FaultState::kRaised, FaultKind::kStale, 3));
+  p.restore(restored(Sensor::kAccelerometer, FaultState::kRaised, FaultKind::kBias, 2));
+  p.restore(restored(Sensor::kUnknown, FaultState::kClearedUnacknowledged, FaultKind::kInvalid, 1));
+  p.start();
+  auto events = [&] {
+    std::lock_guard<std::mutex> l(c.m);
+    return c.events;
+  };
+  auto wait_events = [&](std::size_t n) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (events().size() < n && std::chrono::steady_clock::now() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return events().size() >= n;
+  };
+  // THEN each is re-published at once with its own sequence and state
+  ASSERT_TRUE(wait_events(3));
+  auto ev = events();
+  EXPECT_EQ(ev[0].sensor, Sensor::kGyro);
+  EXPECT_EQ(ev[0].sequence, 3u);
+  EXPECT_EQ(ev[0].state, FaultState::kRaised);
+  EXPECT_EQ(ev[1].sequence, 2u);
+  EXPECT_EQ(ev[2].sequence, 1u);
+  EXPECT_EQ(ev[2].state, FaultState::kClearedUnacknowledged);
+  // WHEN the operator acknowledges the restored gyro #3 and the unknown #1
+  p.push_ack({Sensor::kGyro, 3, "op"});
+  p.push_ack({Sensor::kUnknown, 1, "op"});
+  ASSERT_TRUE(wait_events(5));
+  ev = events();
+  // THEN the acks are accepted and the sequences continue
+  EXPECT_EQ(ev[3].sensor, Sensor::kGyro);
+  EXPECT_EQ(ev[3].sequence, 4u);
+  EXPECT_EQ(ev[3].state, FaultState::kActiveAcknowledged);
+  EXPECT_EQ(ev[3].t, 20.0) << "no sample yet: the event keeps the restored stamp";
+  EXPECT_EQ(ev[4].sensor, Sensor::kUnknown);
+  EXPECT_EQ(ev[4].sequence, 2u);
+  EXPECT_EQ(ev[4].state, FaultState::kAcknowledged);
+  // WHEN healthy samples arrive for longer than restore_recheck
+  feed(p, 0.0, 3.0);
+  // THEN the stale gyro fault, no longer seen, is cleared (acknowledged already: #5
+  // acknowledged); the residual accelerometer fault stays raised (the detector is not armed
+  // again yet, so it cannot tell)
+  ASSERT_TRUE(wait_events(6)) << all_logs(&c);
+  ASSERT_TRUE(wait_status(&c, std::chrono::milliseconds(5000),
+                          [](const PipelineStatus& s) { return s.samples >= 140; }));
+  p.stop();
+  ev = events();
+  ASSERT_EQ(ev.size(), 6u) << all_logs(&c);
+  EXPECT_EQ(ev[5].sensor, Sensor::kGyro);
+  EXPECT_EQ(ev[5].sequence, 5u);
+  EXPECT_EQ(ev[5].state, FaultState::kAcknowledged);
+  EXPECT_EQ(ev[5].kind, FaultKind::kStale);
+  EXPECT_NE(ev[5].message.find("not present after the restart"), std::string::npos)
+      << ev[5].message;
+  EXPECT_GE(ev[5].t, 1.0);
+  EXPECT_TRUE(logged(&c, "restored gyro fault (stale) not present after the restart"))
+      << all_logs(&c);
+}
+
+TEST(FdiPipelineRestore, RestoredResidualFaultIsClearedOnceTheReArmedDetectorSeesNone) {
+  // GIVEN a restored accelerometer bias fault (raised, #4) and the paper's fast-arming
+  // settings, fed a healthy voyage
+  VesselModel v;
+  ASSERT_TRUE(find_vessel("otter", &v));
+  SimConfig sim = paper_scenario(v, 50.0, 1);
+  sim.sigma_v = sim.sigma_r = 0.0;
+  sim.faults.clear();
+  sim.duration = 40.0;
+  EngineConfig cfg;
+  cfg.B = v.B;
+  cfg.identification.eps1 = 2.0;
+  cfg.identification.settle_windows = 2;
+  cfg.identification.settle_tolerance = 0.02;
+  cfg.isolation.sigma_v = 0.005;
+  cfg.isolation.sigma_r = 0.0005;
+  cfg.isolation.settle_time = 2.0;
+  cfg.isolation.learn_time = 3.0;
+  Collected c;
+  PipelineOptions opt;
+  opt.input_capacity = 1 << 16;
+  opt.lockstep = true;
+  opt.restore_recheck = 2.0;
+  FdiPipeline p = make(cfg, &c, opt);
+  FaultEvent e;
+  e.sensor = Sensor::kAccelerometer;
+  e.state = FaultState::kRaised;
+  e.kind = FaultKind::kBias;
+  e.sequence = 4;
+  p.restore(e);
+  p.start();
+  for (const SimRow& r : simulate(sim)) {
+    p.push_rudder({r.t, r.delta, true});
+    p.push_ins({r.t, r.v, r.r, true, true});
+  }
+  p.stop();
+  // THEN it is cleared (still awaiting an acknowledgement) after the detector re-armed
+  ASSERT_EQ(c.events.size(), 2u) << all_logs(&c);
+  EXPECT_EQ(c.events[1].sequence, 5u);
+  EXPECT_EQ(c.events[1].state, FaultState::kClearedUnacknowledged);
+  EXPECT_NE(c.events[1].message.find("re-armed detector has seen no fault for 2.0 s"),
+            std::string::npos)
+      << c.events[1].message;
+  EXPECT_GT(c.events[1].t, 10.0);
+  EXPECT_LT(c.events[1].t, 30.0);
+}
+
+TEST(FdiPipelineOutput, AnOverflowStillPublishesTheLatestStateOfEveryInstance) {
+  // GIVEN an output queue of one element and a writer that blocks on its first event until
+  // the queue has overflowed (statuses every 10 ms push the queued events out)
+  std::mutex m;
+  std::vector<FaultEvent> published;
+  std::vector<std::string> logs;
+  PipelineOptions opt;
+  opt.output_capacity = 1;
+  opt.status_period = 0.01;
+  FdiPipeline* self = nullptr;
+  FdiPipeline p(
+      otter(), opt,
+      [&](const FaultEvent& e) {
+        bool first;
+        {
+          std::lock_guard<std::mutex> l(m);
+          first = published.empty();
+          published.push_back(e);
+        }
+        const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (first && self->status().dropped_output < 3 &&
+               std::chrono::steady_clock::now() < end) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+      },
+      nullptr,
+      [&](int, const std::string& s) {
+        std::lock_guard<std::mutex> l(m);
+        logs.push_back(s);
+      });
+  self = &p;
+  for (Sensor s : {Sensor::kAccelerometer, Sensor::kGyro, Sensor::kUnknown}) {
+    FaultEvent e;
+    e.sensor = s;
+    e.state = FaultState::kRaised;
+    e.kind = FaultKind::kStale;
+    e.sequence = 10 + static_cast<std::uint64_t>(s);
+    p.restore(e);
+  }
+  // WHEN the three restored instances are emitted at start
+  p.start();
+  // THEN each instance's latest state is published all the same, once
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  for (;;) {
+    {
+      std::lock_guard<std::mutex> l(m);
+      if (published.size() >= 3) break;
+    }
+    ASSERT_LT(std::chrono::steady_clock::now(), end) << "not every instance was published";
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  p.stop();
+  std::lock_guard<std::mutex> l(m);
+  ASSERT_EQ(published.size(), 3u);
+  std::set<std::uint64_t> seqs;
+  for (const FaultEvent& e : published) seqs.insert(e.sequence);
+  EXPECT_EQ(seqs, (std::set<std::uint64_t>{10, 11, 12}));
+  EXPECT_GE(p.status().dropped_output, 3u);
+  bool said = false;
+  for (const auto& s : logs) said |= s.find("output queue overflowed") != std::string::npos;
+  EXPECT_TRUE(said);
 }
 
 }  // namespace

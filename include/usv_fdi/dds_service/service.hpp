@@ -9,6 +9,7 @@
 
 #include "usv_fdi/core/engine.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
+#include "usv_fdi/dds_service/journal.hpp"
 #include "usv_fdi/service/pipeline.hpp"
 
 namespace usvfdi::service {
@@ -21,13 +22,21 @@ struct ServiceConfig {
   bool reliable_inputs = false;  ///< INS and rudder readers RELIABLE instead of BEST_EFFORT
   std::string log_level = "info";
   std::string config_file;  ///< where it was loaded from (for messages)
+  /// Directory of the state journal (latched faults survive a restart); "" : none.
+  std::string state_dir;
+  /// false: state_dir is the default (kDefaultStateDir), used only if it exists;
+  /// true: set by service.state_dir or --state-dir (created if missing; "" disables).
+  bool state_dir_explicit = false;
+  std::string health_file;  ///< service.health_file / --health-file ("" : none)
 };
 
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
 ///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
 ///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
 ///   reliable_inputs, status_rate [Hz], log_level, authorised_operators: [..],
-///   input_queue, rudder_wait, rudder_timeout, input_timeout.
+///   input_queue, rudder_wait, rudder_timeout, input_timeout, restore_recheck,
+///   state_dir (relative to the config file; "" : no persistence), health_file.
+/// state_dir defaults to kDefaultStateDir (used if it exists).
 /// Throws usvfdi::io::ConfigError naming file, key, line and value.
 ServiceConfig load_service_config(const std::string& path);
 
@@ -49,6 +58,14 @@ class FdiService {
   /// Idempotent; the destructor calls it.
   void stop();
   PipelineStatus status() const { return pipeline_->status(); }
+  PipelineLiveness liveness() const { return pipeline_->liveness(); }
+
+  /// The state journal's file ("" when state is not persisted) and the error of its last
+  /// failed save ("" when fine).
+  std::string state_file() const { return journal_ ? journal_->path() : std::string(); }
+  std::string state_error() const { return journal_ ? journal_->last_error() : std::string(); }
+  /// The fault instances restored from the journal at construction.
+  const std::vector<FaultEvent>& restored() const { return restored_; }
 
   /// Matched remote endpoints (for the operator's log); all zero after stop().
   struct Matches {
@@ -67,8 +84,12 @@ class FdiService {
 
  private:
   class Listener;
+  void open_journal();
   ServiceConfig cfg_;
   LogSink log_;
+  std::unique_ptr<StateJournal> journal_;
+  std::vector<FaultEvent> restored_;
+  std::string journal_error_logged_;  ///< publisher thread: the save error already logged
   std::unique_ptr<FdiPipeline> pipeline_;
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<usv_fdi::dds::DdsContext> dds_;

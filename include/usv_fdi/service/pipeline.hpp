@@ -3,10 +3,15 @@
 //   latch, acks) -> identification queue -> identification thread (DREM, publishes estimate
 //   snapshots back to the isolation thread) ; isolation thread -> output queue -> publisher
 //   thread (hands events and status to the sink, so a slow writer never blocks isolation).
-// Overflow policy: every queue drops its oldest element when full and counts the drop.
+// Overflow policy: every queue drops its oldest element when full and counts the drop; the
+// latest state of every fault instance still reaches the sink after an output overflow.
+// Input problems (bad stamps, invalid values, gaps, re-ordering, overflow, silent streams) are
+// counted, flagged in the status and logged once per status period with an example.
 #pragma once
 
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <climits>
 #include <condition_variable>
 #include <cstdint>
@@ -44,10 +49,12 @@ struct AckInput {
 };
 
 /// Pairs INS samples with the rudder angle at the same source time: linear interpolation
-/// between the rudder samples around it; when no later rudder sample arrives within
-/// rudder_wait (source time), the last one is held if it is younger than rudder_timeout,
-/// else delta is missing (NaN) and the FDI pauses. INS samples are re-ordered by stamp
-/// inside the wait.
+/// between the rudder samples around it when both are within rudder_timeout (a longer gap
+/// is not bridged: the near side is held, else nothing); when no later rudder sample
+/// arrives within rudder_wait (source time), the last one is held if it is younger than
+/// rudder_timeout, else delta is missing (NaN) and the FDI pauses. INS samples are
+/// re-ordered by stamp inside the wait; samples with a non-finite stamp are ignored (the
+/// pipeline counts them before).
 class SampleAssembler {
  public:
   SampleAssembler(double rudder_wait, double rudder_timeout)
@@ -75,6 +82,10 @@ struct PipelineOptions {
   double input_timeout = 1.0;          ///< INS silent this long (wall clock): stale [s]
   double status_period = 1.0;          ///< FdiStatus period (wall clock) [s]
   double snapshot_period = 0.2;        ///< estimate snapshots (source time) [s]
+  /// A fault restored at start (raised or active-acknowledged) whose sensor-level condition
+  /// (stale, stuck, invalid) is no longer seen for this long is cleared [s, source time];
+  /// a residual fault once the re-armed detector has learned and sees none.
+  double restore_recheck = 5.0;
   /// stop(): events and status still queued for the sink are handed over for at most this
   /// long (wall clock); what is left after it is dropped and counted (dropped_output) [s].
   double stop_drain_timeout = 0.5;
@@ -84,6 +95,37 @@ struct PipelineOptions {
   /// Operators allowed to acknowledge (empty: anyone who can write the ack topic).
   std::vector<std::string> authorised_operators;
 };
+
+/// Input problems (PipelineStatus::input_flags). The values are those of the INPUT_*
+/// constants of idl/usv_fdi.idl (FdiStatus.input_flags).
+enum InputFlag : std::uint32_t {
+  kInputInsSilent = 1u << 0,      ///< no INS sample for input_timeout (wall clock)
+  kInputRudderMissing = 1u << 1,  ///< no usable rudder angle: identification, isolation paused
+  kInputAccelUnusable = 1u << 2,  ///< accelerometer channel v stale, invalid or stuck
+  kInputGyroUnusable = 1u << 3,   ///< gyro channel r stale, invalid or stuck
+  // Since the previous status:
+  kInputBadTimestamps = 1u << 4,  ///< stamps that repeat, go backwards or are not finite
+  kInputInvalidValues = 1u << 5,  ///< NaN (flagged valid), infinite or absurd values
+  kInputGaps = 1u << 6,           ///< gaps between INS samples longer than stale_timeout
+  kInputReordered = 1u << 7,      ///< samples delivered out of order (re-sorted)
+  kInputQueueDrops = 1u << 8,     ///< input queue overflow: oldest samples dropped
+};
+
+/// Why identification or isolation is paused (PipelineStatus::identification_paused,
+/// isolation_paused; the PAUSE_* constants of idl/usv_fdi.idl). 0: running.
+enum PauseReason : std::uint32_t {
+  kPauseNotArmed = 1u << 0,       ///< isolation: A not identified yet (not armed)
+  kPauseLearning = 1u << 1,       ///< isolation: observers settling / learning healthy statistics
+  kPauseRudderMissing = 1u << 2,  ///< no usable rudder angle
+  kPauseInsUnusable = 1u << 3,    ///< identification: an INS channel stale, invalid or stuck
+  kPauseInsSilent = 1u << 4,      ///< no INS samples at all
+  kPauseFault = 1u << 5,          ///< identification: a fault suspected, active or just cleared
+  kPauseObserver = 1u << 6,       ///< isolation: observer design refused (see observer_problem)
+};
+
+/// Names of the set bits ("ins_silent", "rudder_missing", ...), comma-separated.
+std::string input_flag_names(std::uint32_t flags);
+std::string pause_reason_names(std::uint32_t reasons);
 
 /// What the status topic reports.
 struct PipelineStatus {
@@ -97,13 +139,28 @@ struct PipelineStatus {
   std::uint64_t rejected = 0;        ///< samples the engine refused (time not increasing)
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
+  // Input problems, counted since start (see InputFlag for the per-period flags).
+  std::uint32_t input_flags = 0;            ///< InputFlag bits
+  std::uint64_t rejected_timestamps = 0;    ///< repeated/backward (engine) + non-finite stamps
+  std::uint64_t invalid_values = 0;         ///< NaN flagged valid, Inf, absurd magnitudes
+  std::uint64_t gaps = 0;                   ///< gaps longer than stale_timeout
+  std::uint64_t reordered = 0;              ///< INS samples older than one already received
+  std::uint32_t identification_paused = 0;  ///< PauseReason bits (0: identifying)
+  std::uint32_t isolation_paused = 0;       ///< PauseReason bits (0: detecting)
+};
+
+/// Wall-clock seconds since each thread last went round its loop (an idle thread still goes
+/// round every 50-100 ms), and since the last INS / rudder sample arrived (negative: none yet).
+struct PipelineLiveness {
+  double isolation = 0.0, identification = 0.0, publisher = 0.0;
+  double ins_age = -1.0, rudder_age = -1.0;
 };
 
 class FdiPipeline {
  public:
   using EventSink = std::function<void(const FaultEvent&)>;
   using StatusSink = std::function<void(const PipelineStatus&)>;
-  /// level: 0 debug, 1 info, 2 warning, 3 error.
+  /// level: 0 debug, 1 info, 2 warning, 3 error. Called from every thread of the pipeline.
   using LogSink = std::function<void(int level, const std::string&)>;
 
   /// Throws std::invalid_argument on a bad configuration.
@@ -114,7 +171,9 @@ class FdiPipeline {
   FdiPipeline& operator=(const FdiPipeline&) = delete;
 
   /// Restores latched events (restart without loss); call before start(). Each one is
-  /// re-published on start with its sequence.
+  /// re-published on start with its sequence; later events of its instance continue the
+  /// sequence. A restored active fault (raised, active-acknowledged) is checked again: see
+  /// PipelineOptions::restore_recheck.
   void restore(const FaultEvent& ev);
 
   void start();
@@ -122,11 +181,19 @@ class FdiPipeline {
   void stop();
 
   // Called from middleware listeners: copy into the input queue, never block.
-  bool push_ins(const InsInput& s) { return input_.push(s); }
-  bool push_rudder(const RudderInput& s) { return input_.push(s); }
+  bool push_ins(const InsInput& s) {
+    last_ins_ns_.store(now_ns(), std::memory_order_relaxed);
+    return input_.push(s);
+  }
+  bool push_rudder(const RudderInput& s) {
+    last_rudder_ns_.store(now_ns(), std::memory_order_relaxed);
+    return input_.push(s);
+  }
   bool push_ack(const AckInput& a) { return input_.push(a); }
 
   PipelineStatus status() const;
+  /// For a health check: how recently each thread went round its loop.
+  PipelineLiveness liveness() const;
 
  private:
   using Input = std::variant<InsInput, RudderInput, AckInput>;
@@ -135,15 +202,51 @@ class FdiPipeline {
     Sample s;
     bool freeze = false;
   };
+  /// A restored active fault awaiting its re-check.
+  struct Recheck {
+    bool pending = false;
+    FaultKind kind = FaultKind::kUnknown;
+    double ok_since = kNaN;  ///< source time since when its condition is not seen
+  };
+  /// Counters of input problems found by the pipeline itself (the engine counts the rest),
+  /// with the latest example of each for the log.
+  struct InputProblems {
+    std::uint64_t bad_stamps = 0;  ///< non-finite stamps (INS and rudder), dropped
+    std::uint64_t invalid = 0;     ///< NaN flagged valid (INS), unusable rudder angles
+    std::uint64_t reordered = 0;
+    /// The first few examples since the last log, per kind (stamps, values, gaps, order).
+    enum Kind { kStamp = 0, kValue, kGap, kOrder };
+    std::array<std::vector<std::string>, 4> examples;
+    void example(Kind k, std::string text) {
+      if (examples[k].size() < 3) examples[k].push_back(std::move(text));
+    }
+    std::string examples_of(Kind k);  ///< "a; b; c", and forgets them
+  };
+  /// What the previous status period's log summary had seen.
+  struct ProblemCounts {
+    std::uint64_t rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
+                  dropped_inputs = 0;
+  };
 
+  static std::int64_t now_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
   void isolation_loop();
   void identification_loop();
   void publisher_loop();
+  void accept_ins(const InsInput& in);
+  void accept_rudder(const RudderInput& in);
   void process(const Sample& s);
+  void recheck_restored(const Sample& s);
   void emit(const FaultEvent& ev);
+  void publish(const FaultEvent& ev);
+  void publish_latest();
   void handle_ack(const AckInput& a);
   void log(int level, const std::string& msg) const;
-  PipelineStatus make_status() const;
+  void log_input_changes(const PipelineStatus& st);
+  PipelineStatus make_status();
 
   EngineConfig cfg_;
   PipelineOptions opt_;
@@ -161,9 +264,18 @@ class FdiPipeline {
                                      FaultLatch(Sensor::kUnknown)};
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
+  std::array<Recheck, 3> recheck_{};
   double last_t_ = kNaN;
+  double newest_ins_stamp_ = -1e300;
   std::uint64_t seen_version_ = 0;
   Estimate iso_estimate_;
+  InputProblems problems_;
+  ProblemCounts logged_;        ///< counts at the previous status (per-period flags, log)
+  bool rudder_paused_ = false;  ///< logged state of the rudder pause
+  double newest_rudder_stamp_ = -1e300;
+  bool had_ins_ = false;           ///< an INS sample has arrived since start
+  bool never_ins_logged_ = false;  ///< "no INS sample since start" was logged
+  std::chrono::steady_clock::time_point started_at_{};
 
   // Identification thread state.
   Identifier ident_;
@@ -175,12 +287,22 @@ class FdiPipeline {
   std::uint64_t snapshot_version_ = 0;
   PipelineStatus last_status_;
 
+  // The latest event of each instance (isolation thread writes, publisher reads), under
+  // latest_m_: after an overflow of the output queue the publisher still writes each
+  // instance's latest state. Published sequences: publisher thread only.
+  std::mutex latest_m_;
+  std::array<FaultEvent, 3> latest_{};
+  std::array<std::uint64_t, 3> published_seq_{0, 0, 0};
+
   std::atomic<std::uint64_t> samples_{0}, rejected_{0};
   // Lockstep bookkeeping, under step_m_.
   std::mutex step_m_;
   std::condition_variable step_cv_;
   std::uint64_t ident_pushed_ = 0, ident_done_ = 0;
   std::atomic<bool> ins_silent_{false};
+  // Liveness (steady_clock ns): each thread's last loop, the last INS / rudder arrival.
+  std::atomic<std::int64_t> beat_iso_{0}, beat_ident_{0}, beat_pub_{0};
+  std::atomic<std::int64_t> last_ins_ns_{0}, last_rudder_ns_{0};
   /// Set by stop() before the output queue shuts down: the publisher thread drops (and
   /// counts) what it cannot hand over before this steady_clock time (ns since its epoch).
   std::atomic<std::int64_t> drain_deadline_ns_{INT64_MAX};
