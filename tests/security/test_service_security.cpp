@@ -113,7 +113,7 @@ class ServiceSecurity : public ::testing::Test {
            "/";
     fs::create_directories(dir_);
     domain_ = std::to_string(1 + ::getpid() % 200);
-    partition_ = "usv_fdi_service_security_" + std::to_string(::getpid());
+    partition_ = "usv_fdi_service_security_" + std::to_string(::getpid()) + "_vessel-";
   }
   void TearDown() override {
     procs_.clear();
@@ -125,13 +125,17 @@ class ServiceSecurity : public ::testing::Test {
     }
   }
 
-  /// Starts `usv-fdi args` as `id`, with the test's domain and partition; stderr to <name>.log.
+  /// Starts `usv-fdi args` as `id`, with the test's domain; stderr to <name>.log. Partitions as
+  /// in the fleet (docker/compose.secure.yaml): the vessel's (sidecar, sensors)
+  /// <prefix>vessel-<MMSI>, a monitor's <prefix>vessel-* (so access control sees the wildcard the
+  /// shore uses).
   ChildProcess& start(const std::string& name, const Identity& id, std::vector<std::string> args) {
+    const std::string partition = partition_ + (args.at(0) == "monitor" ? "*" : kM);
     std::vector<std::string> argv = {kExe};
     argv.insert(argv.end(), args.begin(), args.end());
     argv.insert(argv.end(),
                 {"--qos", kSource + "/config/qos/usv_fdi_profiles.xml", "--domain", domain_,
-                 "--partition", partition_, "--participant-profile", id.participant});
+                 "--partition", partition, "--participant-profile", id.participant});
     std::vector<std::string> env;  // a plain participant: the shipped profiles only
     if (!id.profiles.empty()) env.push_back("FASTRTPS_DEFAULT_PROFILES_FILE=" + id.profiles);
     auto p = std::make_unique<ChildProcess>(argv, dir_ + name + ".log", env);
@@ -207,7 +211,7 @@ class ServiceSecurity : public ::testing::Test {
   }
 
   Clock::time_point t0_;
-  std::string dir_, domain_, partition_;
+  std::string dir_, domain_, partition_;  ///< partition_: the prefix of the test's partitions
   std::map<std::string, std::unique_ptr<ChildProcess>> procs_;
 };
 
