@@ -48,6 +48,11 @@ ServiceFleet::ServiceFleet(Options o)
   }
   dir_ = ::testing::TempDir() + "usv_fdi_" + test + "_" + std::to_string(::getpid()) + "/";
   fs::create_directories(dir_);
+  if (!opt_.secure_pki.empty()) {
+    // As in docker/compose.secure.yaml.
+    env_ = {"FASTRTPS_DEFAULT_PROFILES_FILE=" + opt_.secure_pki + "/security_profiles.xml"};
+    return;
+  }
   if (opt_.participant_profiles.empty()) {
     opt_.participant_profiles = kSource + "/docker/fleet_participants.xml";
   }
@@ -70,20 +75,26 @@ double ServiceFleet::now() const {
   return std::chrono::duration<double>(Clock::now() - t0_).count();
 }
 
-std::vector<std::string> ServiceFleet::vessel_dds(unsigned i) const {
+std::vector<std::string> ServiceFleet::vessel_dds(unsigned i, bool sim) const {
+  const std::string profile =
+      opt_.secure_pki.empty()
+          ? opt_.vessel_profile
+          : "usv_fdi_secure_vessel" + std::to_string(i) + (sim ? "-sim" : "") + "_unicast";
   return {"--qos",
           kSource + "/config/qos/usv_fdi_profiles.xml",
           "--participant-profile",
-          opt_.vessel_profile,
+          profile,
           "--partition",
           partition(i)};
 }
 
 std::vector<std::string> ServiceFleet::shore_dds() const {
+  const std::string profile =
+      opt_.secure_pki.empty() ? opt_.shore_profile : "usv_fdi_secure_shore_unicast";
   return {"--qos",
           kSource + "/config/qos/usv_fdi_profiles.xml",
           "--participant-profile",
-          opt_.shore_profile,
+          profile,
           "--partition",
           "vessel-*"};
 }
@@ -178,7 +189,7 @@ ChildProcess& ServiceFleet::start_sim(unsigned i, const std::vector<std::string>
                                    "--mmsi",
                                    std::to_string(mmsi(i))};
   argv.insert(argv.end(), extra.begin(), extra.end());
-  const auto d = vessel_dds(i);
+  const auto d = vessel_dds(i, true);
   argv.insert(argv.end(), d.begin(), d.end());
   return start("v" + std::to_string(i), "sim" + std::to_string(i), argv);
 }

@@ -55,6 +55,11 @@ class ServiceFleet {
     std::string participant_profiles;
     std::string vessel_profile = "usv_fdi_participant";
     std::string shore_profile = "usv_fdi_fleet_udp";
+    /// docker/compose.secure.yaml instead: a PKI made by make-security.sh with identities shore,
+    /// vessel<i>, vessel<i>-sim and the fleet's addresses as --initial-peers. Every process then
+    /// loads its security_profiles.xml and runs usv_fdi_secure_<identity>_unicast; no
+    /// ROS_DISCOVERY_SERVER (SIMPLE discovery by unicast; start no discovery servers).
+    std::string secure_pki;
   };
 
   explicit ServiceFleet(Options o);
@@ -102,8 +107,8 @@ class ServiceFleet {
   /// The last few lines of every log, for a failure message.
   std::string logs_tail() const;
 
-  /// DDS options of every usv-fdi process on a vessel / on the shore.
-  std::vector<std::string> vessel_dds(unsigned i) const;
+  /// DDS options of the usv-fdi processes on vessel i (`sim`: of its simulator) / the shore.
+  std::vector<std::string> vessel_dds(unsigned i, bool sim = false) const;
   std::vector<std::string> shore_dds() const;
 
  private:
