@@ -201,6 +201,24 @@ class ServiceSecurity : public ::testing::Test {
   }
   double now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
 
+  /// `monitor --ack SPEC` by the shore identity, again (at most 3 attempts) while the sidecar has
+  /// not taken it and the monitor says "no confirmation from the sidecar": the monitor writes the
+  /// ack 0.3 s after its writer matched, which may precede the sidecar's side of the secure match
+  /// (the ack is then lost). Returns the exit code of the last attempt; *attempts how many.
+  int shore_ack(const std::string& spec, const std::string& accepted, int* attempts) {
+    int code = -1;
+    for (*attempts = 1; *attempts <= 3; ++*attempts) {
+      const std::string name = "ack" + std::to_string(*attempts);
+      code = run(name, fleet_id("shore"), {"monitor", "--ack", spec, "--operator", "shore-op"},
+                 seconds(40));
+      if (log("sidecar").find(accepted) != std::string::npos ||
+          log(name).find("no confirmation from the sidecar") == std::string::npos) {
+        break;
+      }
+    }
+    return code;
+  }
+
   /// The sidecar's own record after SIGTERM: the events it published and its counters.
   std::string stop_sidecar() {
     ChildProcess& p = *procs_.at("sidecar");
@@ -254,10 +272,11 @@ TEST_F(ServiceSecurity, AuthorisedShoreReceivesTheEventsAndAcknowledges) {
   EXPECT_GE(gyro.back().c_g, 0.8) << mon.dump();
   EXPECT_GE(mon.of(kMmsi, "accelerometer").back().c_a, 0.8) << mon.dump();
   // WHEN the shore acknowledges the cleared gyro event
-  const int ack = run("ack", fleet_id("shore"),
-                      {"monitor", "--ack", kM + ":gyro:2", "--operator", "shore-op"}, seconds(40));
+  int attempts = 0;
+  const int ack = shore_ack(kM + ":gyro:2", "ack of gyro #2 by shore-op accepted", &attempts);
   // THEN the sidecar accepts it and the shore sees the event acknowledged
-  EXPECT_EQ(ack, 0) << log("ack") << log("sidecar");
+  EXPECT_EQ(ack, 0) << log("ack1") << log("sidecar");
+  std::printf("shore ack accepted after %d attempt(s)\n", attempts);
   EXPECT_NE(log("sidecar").find("ack of gyro #2 by shore-op accepted"), std::string::npos)
       << log("sidecar");
   EXPECT_TRUE(read_monitor_until(shore, &mon, seconds(10), t0_, [](const MonitorLog& l) {
@@ -296,11 +315,11 @@ TEST_F(ServiceSecurity, ReadOnlyObserverReadsButCannotAcknowledge) {
   EXPECT_EQ(shore.of(kMmsi, "accelerometer").at(0).state, "raised");
   EXPECT_EQ(shore.of(kMmsi, "accelerometer").at(0).sequence, 1u);
   // (control: the same ack by the shore identity is accepted)
+  int attempts = 0;
   EXPECT_EQ(
-      run("shore_ack", fleet_id("shore"),
-          {"monitor", "--ack", kM + ":accelerometer:1", "--operator", "shore-op"}, seconds(40)),
+      shore_ack(kM + ":accelerometer:1", "ack of accelerometer #1 by shore-op accepted", &attempts),
       0)
-      << log("shore_ack") << log("sidecar");
+      << log("ack1") << log("sidecar");
   stop_sidecar();
 }
 
