@@ -1,16 +1,18 @@
 // The fleet of docker/compose.yaml without Docker (issue 4): every vessel and the shore a host of
 // its own (network namespace + /dev/shm, tests/fleet/netns.sh), the real `usv-fdi` executable
 // as each vessel's sidecar (`run`) and simulator (`sim --publish`) and as the shore monitor
-// (`monitor --json --status`), discovery through two Fast DDS discovery servers on the shore
-// (no multicast on any link). See service_fleet.hpp for the transports and partitions, and why.
+// (`monitor --json --status`), discovery through two Fast DDS discovery servers on hosts of their
+// own (no multicast on any link). See service_fleet.hpp for the transports and partitions, and
+// why.
 //
 //   FleetService.FiveVesselsEachSeenWithItsOwnFaults
 //   FleetService.SecureFleetWithUnicastDiscovery   (docker/compose.secure.yaml)
 //   FleetPartition.ShorterThanTheLeaseRepairedByReliableResend
 //   FleetPartition.LongerThanTheLeaseRediscoveredWithTheLatchedState
 //
-// The simulators publish noise-free voyages 10 times faster than real time. Every wait is bounded;
-// the test skips (with the reason) where namespaces cannot be made (not root, no iproute2).
+// The simulators publish noise-free voyages 10 times (partition tests: 5 times) faster than real
+// time. Every wait is bounded; the tests skip (with the reason) where namespaces cannot be made
+// (not root, no iproute2).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
