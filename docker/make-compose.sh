@@ -5,7 +5,11 @@
 #   vessel<i>                usv-fdi run, the sidecar of vessel i, MMSI 257000000+i  10.77.0.(10+i)
 #   vessel<i>-sim            usv-fdi sim --publish: vessel i's INS and rudder, sharing the
 #                            sidecar's network and IPC namespaces (one vessel = one host)
-# Addresses and MMSIs are the same as in the namespace fleet test (tests/fleet/netns.sh).
+# Addresses, MMSIs, participant profiles, partitions, discovery servers and the sidecar's engine
+# config are those of the namespace fleet test (tests/fleet/service_fleet.hpp, which runs this
+# topology with the real executables; docker/check-compose.sh keeps the two in step):
+#   every vessel's sidecar and simulator in DDS partition vessel-<MMSI> (the INS and rudder
+#   samples stay on the vessel), the shore in vessel-* (every vessel's events, status and acks).
 #
 #   docker/make-compose.sh [--secure] [N]      N: 1..200, default 3
 #
@@ -90,6 +94,8 @@ x-usv-fdi: &usv-fdi
   cap_drop: [ALL]
   security_opt: ["no-new-privileges:true"]
 
+# No ROS_DISCOVERY_SERVER on the servers: the 2.9 server given it takes the listed addresses,
+# its own included, for remote servers and aborts (tests/fleet/service_fleet.cpp).
 x-discovery: &discovery
   image: usv-fdi-discovery:latest
   build:
@@ -129,7 +135,8 @@ cat <<YAML
     <<: *usv-fdi
     # Its own network and IPC namespaces: Fast DDS derives another host id from its address, so it
     # never tries shared memory with the vessels and talks UDP through the bridge.
-    command: ["monitor", "--json", "--participant-profile", "$(participant shore usv_fdi_fleet_udp)"]$depends
+    command: ["monitor", "--json", "--status", "--partition", "vessel-*",
+              "--participant-profile", "$(participant shore usv_fdi_fleet_udp)"]$depends
     healthcheck:
       disable: true
     networks:
@@ -145,8 +152,9 @@ for i in $(seq 1 "$n"); do
   vessel$i:
     <<: *usv-fdi
     hostname: vessel$i
-    command: ["run", "--config", "/usr/local/share/usv-fdi/config/vessels/otter.yaml",
-              "--mmsi", "$mmsi", "--participant-profile", "$(participant "vessel$i" usv_fdi_participant)",
+    command: ["run", "--config", "/usr/local/share/usv-fdi/config/scenarios/paper.yaml",
+              "--mmsi", "$mmsi", "--reliable-inputs", "--partition", "vessel-$mmsi",
+              "--participant-profile", "$(participant "vessel$i" usv_fdi_participant)",
               "--health-file", "/run/usv-fdi/health.json"]
     # The vessel's simulator joins this container's IPC namespace (/dev/shm): Fast DDS may then use
     # shared memory between them, as on a real vessel's computer.
@@ -159,8 +167,12 @@ for i in $(seq 1 "$n"); do
 
   vessel$i-sim:
     <<: *usv-fdi
+    # The paper's faults (gyro 20-40 s, accelerometer 60-80 s), then a day of healthy voyage. Not
+    # restarted when it ends: a new voyage would start its clock at 0 again.
     command: ["sim", "--publish", "--vessel", "otter", "--scenario", "paper", "--rate", "50",
-              "--mmsi", "$mmsi", "--participant-profile", "$(participant "vessel$i-sim" usv_fdi_participant)"]
+              "--duration", "86400", "--mmsi", "$mmsi", "--reliable", "--partition", "vessel-$mmsi",
+              "--participant-profile", "$(participant "vessel$i-sim" usv_fdi_participant)"]
+    restart: on-failure
     # Same network AND IPC namespaces as its sidecar: same addresses (so the same Fast DDS host id)
     # and the same /dev/shm, so shared-memory transport between them works.
     network_mode: "service:vessel$i"

@@ -1,0 +1,419 @@
+// DDS Security at the service level (issue 4): the real `usv-fdi` executable as sidecar (`run`),
+// sensor gateway (`sim --publish`) and shore monitor (`monitor`), each in its own process over
+// Fast DDS on UDPv4 bound to 127.0.0.1, every participant made from the secure participant
+// profile of its identity that scripts/make-security.sh generated (FASTRTPS_DEFAULT_PROFILES_FILE
+// = its security_profiles.xml, `--participant-profile usv_fdi_secure_<identity>_loopback`): PKI-DH
+// authentication, Access-Permissions, AES-GCM-GMAC, as docker/compose.secure.yaml runs them.
+//
+// Identities (one test PKI per test process): vessel (the sidecar: writes events and status, reads
+// INS, rudder, acks), sensors (the simulator: writes INS and rudder), shore (reads events and
+// status, writes acks), observer (reads only); and a foreign CA's "shore" and "sensors" with the
+// real ones' subject names. The sidecar runs the paper scenario's first 70 s (gyro fault raised
+// at 20.24 s and cleared at 41.4 s, accelerometer fault raised at 60.24 s) at 25 times real time.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "monitor_log.hpp"
+#include "process.hpp"
+
+namespace usv_fdi::security::test {
+namespace {
+
+using dds::test::ChildProcess;
+using fleet::test::MonitorLog;
+using fleet::test::number_before;
+using fleet::test::read_monitor_until;
+using fleet::test::sidecar_events;
+using fleet::test::SidecarEvent;
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+constexpr const char* kExe = USV_FDI_EXE;
+const std::string kSource = USV_FDI_SOURCE_DIR;
+constexpr unsigned kMmsi = 257000001;
+const std::string kM = std::to_string(kMmsi);
+
+fs::path g_pki;  // set by the environment below
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
+}
+
+/// Makes the two PKIs once for the test program, removes them at the end.
+class PkiEnvironment : public ::testing::Environment {
+ public:
+  void SetUp() override {
+#ifdef USV_FDI_LSAN_SUPPRESSIONS  // ASan build: Fast DDS's own leaks (lsan.supp)
+    ::setenv("LSAN_OPTIONS", "suppressions=" USV_FDI_LSAN_SUPPRESSIONS, 0);
+#endif
+    g_pki = fs::path(USV_FDI_SECURITY_WORKDIR) / ("service-pki-" + std::to_string(::getpid()));
+    fs::remove_all(g_pki);
+    fs::create_directories(g_pki);
+    for (const auto& args : std::vector<std::vector<std::string>>{
+             {(g_pki / "fleet").string(), "--identity", "vessel:vessel", "--identity",
+              "sensors:sensors", "--identity", "shore:shore", "--identity", "observer:observer"},
+             {(g_pki / "foreign").string(), "--ca-name", "foreign CA", "--identity", "shore:shore",
+              "--identity", "sensors:sensors"}}) {
+      std::vector<std::string> argv = {USV_FDI_MAKE_SECURITY};
+      argv.insert(argv.end(), args.begin(), args.end());
+      ChildProcess p(argv);
+      const std::string out = p.read_all(milliseconds(60000));
+      ASSERT_EQ(p.wait_exit(milliseconds(5000)).value_or(-1), 0) << out;
+    }
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(g_pki, ec);
+  }
+};
+const auto* const kEnv = ::testing::AddGlobalTestEnvironment(new PkiEnvironment);
+
+/// Who a process is: the profiles file (FASTRTPS_DEFAULT_PROFILES_FILE) and participant profile.
+struct Identity {
+  std::string profiles;  ///< empty: none (a plain participant without DDS Security)
+  std::string participant;
+};
+Identity fleet_id(const std::string& name) {
+  return {(g_pki / "fleet" / "security_profiles.xml").string(),
+          "usv_fdi_secure_" + name + "_loopback"};
+}
+/// An identity of the foreign CA with the name (and subject) of the fleet's identity `name`.
+Identity foreign_id(const std::string& name) {
+  return {(g_pki / "foreign" / "security_profiles.xml").string(),
+          "usv_fdi_secure_" + name + "_loopback"};
+}
+Identity no_identity() { return {"", "usv_fdi_participant_loopback"}; }
+
+class ServiceSecurity : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_FALSE(g_pki.empty());
+    t0_ = Clock::now();
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = ::testing::TempDir() + "usv_fdi_sec_" + info->name() + "_" + std::to_string(::getpid()) +
+           "/";
+    fs::create_directories(dir_);
+    domain_ = std::to_string(1 + ::getpid() % 200);
+    partition_ = "usv_fdi_service_security_" + std::to_string(::getpid()) + "_vessel-";
+  }
+  void TearDown() override {
+    procs_.clear();
+    if (!HasFailure()) {
+      std::error_code ec;
+      fs::remove_all(dir_, ec);
+    } else {
+      std::fprintf(stderr, "logs kept in %s\n", dir_.c_str());
+    }
+  }
+
+  /// Starts `usv-fdi args` as `id`, with the test's domain; stderr to <name>.log. Partitions as
+  /// in the fleet (docker/compose.secure.yaml): the vessel's (sidecar, sensors)
+  /// <prefix>vessel-<MMSI>, a monitor's <prefix>vessel-* (so access control sees the wildcard the
+  /// shore uses).
+  ChildProcess& start(const std::string& name, const Identity& id, std::vector<std::string> args) {
+    const std::string partition = partition_ + (args.at(0) == "monitor" ? "*" : kM);
+    std::vector<std::string> argv = {kExe};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.insert(argv.end(),
+                {"--qos", kSource + "/config/qos/usv_fdi_profiles.xml", "--domain", domain_,
+                 "--partition", partition, "--participant-profile", id.participant});
+    std::vector<std::string> env;  // a plain participant: the shipped profiles only
+    if (!id.profiles.empty()) env.push_back("FASTRTPS_DEFAULT_PROFILES_FILE=" + id.profiles);
+    auto p = std::make_unique<ChildProcess>(argv, dir_ + name + ".log", env);
+    ChildProcess& ref = *p;
+    procs_[name] = std::move(p);
+    return ref;
+  }
+  std::string log(const std::string& name) const { return slurp(dir_ + name + ".log"); }
+  bool wait_for_log(const std::string& name, const std::string& text, milliseconds timeout) {
+    const auto deadline = Clock::now() + timeout;
+    while (log(name).find(text) == std::string::npos) {
+      if (Clock::now() >= deadline) return false;
+      std::this_thread::sleep_for(milliseconds(20));
+    }
+    return true;
+  }
+  /// Runs a process to its end (bounded): exit code (-1: still running), stdout in *out.
+  int run(const std::string& name, const Identity& id, std::vector<std::string> args,
+          milliseconds timeout, std::string* out = nullptr) {
+    ChildProcess& p = start(name, id, std::move(args));
+    const std::string text = p.read_all(timeout);
+    if (out != nullptr) *out = text;
+    return p.wait_exit(milliseconds(5000)).value_or(-1);
+  }
+
+  /// The sidecar (vessel identity): paper scenario's engine config, RELIABLE inputs.
+  ChildProcess& start_sidecar() {
+    const std::string cfg = dir_ + "sidecar.yaml";
+    {
+      std::ofstream f(cfg);
+      f << slurp(kSource + "/config/scenarios/paper.yaml");
+      f << "\nservice:\n  mmsi: " << kMmsi
+        << "\n  reliable_inputs: true\n  status_rate: 5\n  input_timeout: 60\n";
+    }
+    ChildProcess& p = start("sidecar", fleet_id("vessel"), {"run", "--config", cfg});
+    EXPECT_TRUE(wait_for_log("sidecar", "waiting for INS and rudder", seconds(20)))
+        << log("sidecar");
+    return p;
+  }
+  /// The first 70 s of the paper scenario from the authorised sensor gateway, to its end.
+  void run_voyage() {
+    const int code = run("sim", fleet_id("sensors"),
+                         {"sim", "--publish", "--vessel", "otter", "--scenario", "paper",
+                          "--noise-scale", "0", "--reliable", "--mmsi", kM, "--speed", "25",
+                          "--duration", "70", "--linger", "0.5", "--wait-readers", "30"},
+                         seconds(60));
+    ASSERT_EQ(code, 0) << log("sim") << log("sidecar");
+    ASSERT_TRUE(wait_for_log("sidecar", "accelerometer #1 raised", seconds(10))) << log("sidecar");
+  }
+  /// The latched state as one identity sees it (`monitor --json --once`).
+  MonitorLog latched(const std::string& name, const Identity& id, int expect, double duration) {
+    std::string out;
+    std::vector<std::string> args = {"monitor", "--json", "--once", "--duration",
+                                     std::to_string(duration)};
+    if (expect > 0) args.insert(args.end(), {"--expect", std::to_string(expect)});
+    const int code =
+        run(name, id, args, milliseconds(static_cast<int>(duration * 1000) + 20000), &out);
+    EXPECT_EQ(code, 0) << log(name);
+    MonitorLog m;
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);) m.add(line, 0.0);
+    return m;
+  }
+  double now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
+
+  /// `monitor --ack SPEC` by the shore identity, again (at most 3 attempts) while the sidecar has
+  /// not taken it and the monitor says "no confirmation from the sidecar": the monitor writes the
+  /// ack 0.3 s after its writer matched, which may precede the sidecar's side of the secure match
+  /// (the ack is then lost). Returns the exit code of the last attempt; *attempts how many.
+  int shore_ack(const std::string& spec, const std::string& accepted, int* attempts) {
+    int code = -1;
+    for (*attempts = 1; *attempts <= 3; ++*attempts) {
+      const std::string name = "ack" + std::to_string(*attempts);
+      code = run(name, fleet_id("shore"), {"monitor", "--ack", spec, "--operator", "shore-op"},
+                 seconds(40));
+      if (log("sidecar").find(accepted) != std::string::npos ||
+          log(name).find("no confirmation from the sidecar") == std::string::npos) {
+        break;
+      }
+    }
+    return code;
+  }
+
+  /// The sidecar's own record after SIGTERM: the events it published and its counters.
+  std::string stop_sidecar() {
+    ChildProcess& p = *procs_.at("sidecar");
+    p.signal(SIGTERM);
+    EXPECT_EQ(p.wait_exit(milliseconds(5000)).value_or(-1), 0) << log("sidecar");
+    const std::string l = log("sidecar");
+    return l.substr(std::min(l.size(), l.find("stopped in")));
+  }
+
+  Clock::time_point t0_;
+  std::string dir_, domain_, partition_;  ///< partition_: the prefix of the test's partitions
+  std::map<std::string, std::unique_ptr<ChildProcess>> procs_;
+};
+
+/// The events of the first 70 s of the paper scenario, as the sidecar must publish them.
+void expect_clean_voyage_events(const std::vector<SidecarEvent>& ev, const std::string& context) {
+  SCOPED_TRACE(context);
+  ASSERT_EQ(ev.size(), 3u);
+  EXPECT_EQ(ev[0].sensor, "gyro");
+  EXPECT_EQ(ev[0].state, "raised");
+  EXPECT_NEAR(ev[0].t, 20.24, 1.0);
+  EXPECT_EQ(ev[1].sensor, "gyro");
+  EXPECT_EQ(ev[1].state, "cleared");
+  EXPECT_NEAR(ev[1].t, 41.4, 1.0);
+  EXPECT_EQ(ev[2].sensor, "accelerometer");
+  EXPECT_EQ(ev[2].state, "raised");
+  EXPECT_NEAR(ev[2].t, 60.24, 1.0);
+  EXPECT_GE(ev[2].c_a, 0.8);
+  for (const auto& e : ev) EXPECT_EQ(e.mmsi, kMmsi);
+}
+
+TEST_F(ServiceSecurity, AuthorisedShoreReceivesTheEventsAndAcknowledges) {
+  // GIVEN the secured sidecar and an authorised shore monitor (shore identity)
+  start_sidecar();
+  ChildProcess& shore = start("shore", fleet_id("shore"), {"monitor", "--json", "--status"});
+  ASSERT_TRUE(wait_for_log("sidecar", "1 fault-event reader(s)", seconds(30))) << log("sidecar");
+  // WHEN the authorised sensor gateway publishes the voyage
+  run_voyage();
+  // THEN the shore receives the sidecar's events (decrypted, with their C_i) and status
+  MonitorLog mon;
+  ASSERT_TRUE(read_monitor_until(shore, &mon, seconds(15), t0_,
+                                 [](const MonitorLog& l) {
+                                   return l.has(kMmsi, "gyro", "cleared") &&
+                                          l.has(kMmsi, "accelerometer", "raised") &&
+                                          l.last_status(kMmsi) != nullptr &&
+                                          l.last_status(kMmsi)->samples >= 3500;
+                                 }))
+      << mon.dump() << log("shore");
+  const auto gyro = mon.of(kMmsi, "gyro");
+  EXPECT_EQ(gyro.back().sequence, 2u) << mon.dump();
+  EXPECT_GE(gyro.back().c_g, 0.8) << mon.dump();
+  EXPECT_GE(mon.of(kMmsi, "accelerometer").back().c_a, 0.8) << mon.dump();
+  // WHEN the shore acknowledges the cleared gyro event
+  int attempts = 0;
+  const int ack = shore_ack(kM + ":gyro:2", "ack of gyro #2 by shore-op accepted", &attempts);
+  // THEN the sidecar accepts it and the shore sees the event acknowledged
+  EXPECT_EQ(ack, 0) << log("ack1") << log("sidecar");
+  std::printf("shore ack accepted after %d attempt(s)\n", attempts);
+  EXPECT_NE(log("sidecar").find("ack of gyro #2 by shore-op accepted"), std::string::npos)
+      << log("sidecar");
+  EXPECT_TRUE(read_monitor_until(shore, &mon, seconds(10), t0_, [](const MonitorLog& l) {
+    return l.has(kMmsi, "gyro", "acknowledged");
+  })) << mon.dump();
+  const std::string stopped = stop_sidecar();
+  EXPECT_EQ(number_before(stopped, " samples, "), 3501) << stopped;
+}
+
+TEST_F(ServiceSecurity, ReadOnlyObserverReadsButCannotAcknowledge) {
+  // GIVEN the secured sidecar after the voyage: gyro #2 cleared-unacknowledged, accelerometer #1
+  // raised
+  start_sidecar();
+  run_voyage();
+  // WHEN the observer (read-only identity) joins
+  const MonitorLog seen = latched("observer", fleet_id("observer"), 2, 20);
+  // THEN it receives the latched state of both instances
+  ASSERT_EQ(seen.faults.size(), 2u) << seen.dump() << log("observer");
+  EXPECT_EQ(seen.of(kMmsi, "gyro").at(0).state, "cleared");
+  EXPECT_EQ(seen.of(kMmsi, "accelerometer").at(0).state, "raised");
+  EXPECT_EQ(seen.of(kMmsi, "accelerometer").at(0).sequence, 1u);
+  // WHEN it tries to acknowledge the accelerometer event
+  const int ack = run("observer_ack", fleet_id("observer"),
+                      {"monitor", "--ack", kM + ":accelerometer:1", "--operator", "observer-op",
+                       "--discovery-timeout", "5"},
+                      seconds(40));
+  // THEN it cannot: access control refuses it the ack writer, the monitor says so and fails
+  EXPECT_NE(ack, 0) << log("observer_ack");
+  EXPECT_NE(log("observer_ack").find("usv_fdi/fault_ack topic not found in allow rule"),
+            std::string::npos)
+      << log("observer_ack");
+  // AND the sidecar received no ack; the event stays raised and unacknowledged for the shore
+  EXPECT_EQ(log("sidecar").find("ack of"), std::string::npos) << log("sidecar");
+  const MonitorLog shore = latched("shore", fleet_id("shore"), 2, 20);
+  ASSERT_EQ(shore.of(kMmsi, "accelerometer").size(), 1u) << shore.dump();
+  EXPECT_EQ(shore.of(kMmsi, "accelerometer").at(0).state, "raised");
+  EXPECT_EQ(shore.of(kMmsi, "accelerometer").at(0).sequence, 1u);
+  // (control: the same ack by the shore identity is accepted)
+  int attempts = 0;
+  EXPECT_EQ(
+      shore_ack(kM + ":accelerometer:1", "ack of accelerometer #1 by shore-op accepted", &attempts),
+      0)
+      << log("ack1") << log("sidecar");
+  stop_sidecar();
+}
+
+TEST_F(ServiceSecurity, ParticipantsWithoutAValidIdentityCanNeitherReadNorInject) {
+  // GIVEN the secured sidecar, an authorised shore monitor (control), and two intruders: one
+  // without DDS Security, one with a foreign CA's certificates carrying the shore's and the
+  // sensor gateway's names. Each intruder watches the events and status, and publishes INS and
+  // rudder samples of the same vessel with a large accelerometer fault from 5 s on, over the whole
+  // authorised voyage.
+  start_sidecar();
+  ChildProcess& shore = start("shore", fleet_id("shore"), {"monitor", "--json", "--status"});
+  ASSERT_TRUE(wait_for_log("sidecar", "1 fault-event reader(s)", seconds(30))) << log("sidecar");
+  struct Intruder {
+    std::string name;
+    Identity shore, sensors;  ///< reads events, writes acks / writes INS and rudder
+  };
+  const std::vector<Intruder> intruders = {{"plain", no_identity(), no_identity()},
+                                           {"foreign", foreign_id("shore"), foreign_id("sensors")}};
+  for (const auto& in : intruders) {
+    start(in.name + "_monitor", in.shore, {"monitor", "--json", "--status"});
+    start(in.name + "_sim", in.sensors,
+          {"sim",
+           "--publish",
+           "--vessel",
+           "otter",
+           "--scenario",
+           "paper",
+           "--noise-scale",
+           "0",
+           "--reliable",
+           "--mmsi",
+           kM,
+           "--healthy",
+           kM,
+           "--fault",
+           kM + "@accelerometer:bias:5:100000:0.5",
+           "--speed",
+           "25",
+           "--duration",
+           "100000",
+           "--wait-readers",
+           "3"});
+  }
+  for (const auto& in : intruders) {
+    ASSERT_TRUE(wait_for_log(in.name + "_sim", "publishing 1 vessel(s)", seconds(30)))
+        << log(in.name + "_sim");
+  }
+  // WHEN the authorised sensor gateway publishes the voyage and the shore sees it
+  run_voyage();
+  MonitorLog mon;
+  ASSERT_TRUE(read_monitor_until(shore, &mon, seconds(15), t0_, [](const MonitorLog& l) {
+    return l.has(kMmsi, "accelerometer", "raised") && l.last_status(kMmsi) != nullptr &&
+           l.last_status(kMmsi)->samples >= 3501;
+  })) << mon.dump();
+  // ... and the intruders try to acknowledge (both at once)
+  for (const auto& in : intruders) {
+    start(in.name + "_ack", in.shore,
+          {"monitor", "--ack", kM + ":accelerometer:1", "--operator", "intruder",
+           "--discovery-timeout", "5"});
+  }
+  for (const auto& in : intruders) {
+    const int ack = procs_.at(in.name + "_ack")->wait_exit(seconds(30)).value_or(-1);
+    EXPECT_EQ(ack, 1) << log(in.name + "_ack");
+    EXPECT_NE(log(in.name + "_ack").find("no sidecar subscribes to acknowledgements"),
+              std::string::npos)
+        << log(in.name + "_ack");
+  }
+  // THEN the intruders' monitors received nothing, their samples reached no reader
+  for (const auto& in : intruders) {
+    ChildProcess& m = *procs_.at(in.name + "_monitor");
+    ChildProcess& s = *procs_.at(in.name + "_sim");
+    ASSERT_TRUE(s.running()) << in.name << " sim ended early\n" << log(in.name + "_sim");
+    s.signal(SIGTERM);
+    m.signal(SIGTERM);
+    EXPECT_EQ(s.wait_exit(milliseconds(5000)).value_or(-1), 0) << log(in.name + "_sim");
+    const std::string out = m.read_all(milliseconds(5000));
+    EXPECT_EQ(m.wait_exit(milliseconds(5000)).value_or(-1), 0) << log(in.name + "_monitor");
+    EXPECT_EQ(out, "") << in.name << " read the sidecar's topics";
+    EXPECT_NE(log(in.name + "_sim").find("0 INS / 0 rudder reader(s) matched"), std::string::npos)
+        << log(in.name + "_sim");
+    const long long published = number_before(log(in.name + "_sim"), " samples per vessel");
+    EXPECT_GT(published, 100) << "the intruder did not publish\n" << log(in.name + "_sim");
+  }
+  // AND the sidecar's events and counters are exactly those of the authorised voyage: 3501
+  // samples (70 s at 50 Hz), no other fault, no ack
+  EXPECT_EQ(log("sidecar").find("ack of"), std::string::npos) << log("sidecar");
+  EXPECT_EQ(mon.last_status(kMmsi)->samples, 3501u);
+  const std::string stopped = stop_sidecar();
+  expect_clean_voyage_events(sidecar_events(log("sidecar")), log("sidecar"));
+  EXPECT_EQ(number_before(stopped, " samples, "), 3501) << stopped;
+  EXPECT_EQ(number_before(stopped, " rejected"), 0) << stopped;
+  EXPECT_EQ(number_before(stopped, " samples of other vessels skipped"), 0) << stopped;
+  EXPECT_EQ(log("sidecar").find("2 INS writer(s)"), std::string::npos) << log("sidecar");
+}
+
+}  // namespace
+}  // namespace usv_fdi::security::test
