@@ -17,6 +17,7 @@
 //   isolation       Isolator::update (observers, residual evaluation, sensor checks)
 //   engine          FdiEngine::process (both, the identification gate and the latches: the
 //                   whole per-sample update; issue 2's target: under 1 us on one core)
+//   *_noguard       the same with identification's consistency guard off
 //
 // Reported: the median over repetitions of the time per sample, and at the end a summary
 // with each median as a ratio to the baseline measured in the same run.
@@ -56,14 +57,16 @@ struct Dataset {
 
 constexpr double kSteadySeconds = 600.0;
 
-Dataset make_dataset(const std::string& vessel_name, double rate_hz) {
+Dataset make_dataset(const std::string& vessel_name, double rate_hz, bool guard) {
   Dataset d;
-  d.name = vessel_name + "_" + std::to_string(static_cast<int>(rate_hz)) + "Hz";
+  d.name = vessel_name + "_" + std::to_string(static_cast<int>(rate_hz)) + "Hz" +
+           (guard ? "" : " (guard off)");
   d.rate_hz = rate_hz;
   VesselModel vessel;
   if (!find_vessel(vessel_name, &vessel)) throw std::runtime_error("no vessel " + vessel_name);
-  const EngineConfig cfg = io::load_engine_config(std::string(USV_FDI_SOURCE_DIR) +
-                                                  "/config/vessels/" + vessel_name + ".yaml");
+  EngineConfig cfg = io::load_engine_config(std::string(USV_FDI_SOURCE_DIR) + "/config/vessels/" +
+                                            vessel_name + ".yaml");
+  cfg.identification.guard = guard;
   d.A_true = vessel.A;
   d.B = cfg.B;
   // The warm-up covers convergence, observer settling and learning (as the scenario
@@ -110,12 +113,12 @@ Dataset make_dataset(const std::string& vessel_name, double rate_hz) {
   return d;
 }
 
-Dataset& dataset(const std::string& vessel, double rate_hz) {
+Dataset& dataset(const std::string& vessel, double rate_hz, bool guard = true) {
   static std::map<std::string, std::unique_ptr<Dataset>> cache;
-  const std::string key = vessel + "@" + std::to_string(rate_hz);
+  const std::string key = vessel + "@" + std::to_string(rate_hz) + (guard ? "" : "/noguard");
   auto it = cache.find(key);
   if (it == cache.end()) {
-    it = cache.emplace(key, std::make_unique<Dataset>(make_dataset(vessel, rate_hz))).first;
+    it = cache.emplace(key, std::make_unique<Dataset>(make_dataset(vessel, rate_hz, guard))).first;
   }
   return *it->second;
 }
@@ -163,8 +166,9 @@ void bm_baseline(benchmark::State& state, const std::string& vessel, double rate
       });
 }
 
-void bm_identification(benchmark::State& state, const std::string& vessel, double rate_hz) {
-  const Dataset& d = dataset(vessel, rate_hz);
+void bm_identification(benchmark::State& state, const std::string& vessel, double rate_hz,
+                       bool guard = true) {
+  const Dataset& d = dataset(vessel, rate_hz, guard);
   std::unique_ptr<Identifier> ident;
   run_steady(
       state, d, [&] { ident = std::make_unique<Identifier>(*d.ident); },
@@ -190,8 +194,9 @@ void bm_isolation(benchmark::State& state, const std::string& vessel, double rat
   state.counters["detections"] = detections;  // healthy data: 0
 }
 
-void bm_engine(benchmark::State& state, const std::string& vessel, double rate_hz) {
-  const Dataset& d = dataset(vessel, rate_hz);
+void bm_engine(benchmark::State& state, const std::string& vessel, double rate_hz,
+               bool guard = true) {
+  const Dataset& d = dataset(vessel, rate_hz, guard);
   std::unique_ptr<FdiEngine> engine;
   std::vector<FaultEvent> events;
   events.reserve(16);
@@ -302,6 +307,12 @@ void register_all() {
                                  [v, hz](benchmark::State& st) { bm_isolation(st, v, hz); });
     benchmark::RegisterBenchmark(("engine/" + set).c_str(),
                                  [v, hz](benchmark::State& st) { bm_engine(st, v, hz); });
+    // The same with identification's consistency guard off (its cost, side by side).
+    benchmark::RegisterBenchmark(
+        ("identification_noguard/" + set).c_str(),
+        [v, hz](benchmark::State& st) { bm_identification(st, v, hz, false); });
+    benchmark::RegisterBenchmark(("engine_noguard/" + set).c_str(),
+                                 [v, hz](benchmark::State& st) { bm_engine(st, v, hz, false); });
   }
 }
 

@@ -51,6 +51,8 @@ bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
   }
   if (!accepted) return false;
   gate_.push(s, iso_.freeze_requested());
+  const IsolatorStatus& st = iso_.status();
+  ident_.set_supervised(st.armed && !st.learning && !st.settling);
   Sample old;
   bool freeze = false;
   bool updated = false;

@@ -148,6 +148,7 @@ void Isolator::publish_bank() {
 
 void Isolator::set_estimate(const Estimate& est) {
   const double t_now = have_prev_ ? prev_.t : est.t;
+  data_inconsistent_ = !est.consistent || est.inconsistent_time > 0.0;
   if (!st_.armed) {
     if (!est.converged) return;
     if (!design(est.A, &act_)) return;
@@ -526,7 +527,10 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   // within resume_after_fault (a fault that hides with the signal clears and re-raises).
   bool faulty = false;
   for (const Condition& c : cond_) faulty = faulty || c.active;
-  const bool learn_ok = v_ok && r_ok && !faulty && s.t - t_last_fault_ >= p_.resume_after_fault;
+  // Nor while identification finds the data inconsistent with the vessel's dynamics (a
+  // fault no residual sees yet, e.g. one that began while the first design was learning).
+  const bool learn_ok = v_ok && r_ok && !faulty && !data_inconsistent_ &&
+                        s.t - t_last_fault_ >= p_.resume_after_fault;
   double raw[4];
   Vec2 sw;
   bool swapped = false;

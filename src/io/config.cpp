@@ -202,6 +202,10 @@ class Loader {
         {"settle_windows", integ(&id.settle_windows)},
         {"settle_floor", num(&id.settle_floor)},
         {"max_std_error", num(&id.max_std_error)},
+        {"guard", boo(&id.guard)},
+        {"guard_threshold", num(&id.guard_threshold)},
+        {"guard_min_shift", num(&id.guard_min_shift)},
+        {"guard_recent_time", num(&id.guard_recent_time)},
         {"delay", num(&cfg.identification_delay)},
     };
     const std::map<std::string, Handler> isolation = {

@@ -49,6 +49,10 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(x.cubic_correction, y.cubic_correction);
   EXPECT_EQ(x.instruments, y.instruments);
   EXPECT_EQ(x.max_std_error, y.max_std_error);
+  EXPECT_EQ(x.guard, y.guard);
+  EXPECT_EQ(x.guard_threshold, y.guard_threshold);
+  EXPECT_EQ(x.guard_min_shift, y.guard_min_shift);
+  EXPECT_EQ(x.guard_recent_time, y.guard_recent_time);
   EXPECT_EQ(x.a0, y.a0);
   EXPECT_EQ(x.min_excitation, y.min_excitation);
   EXPECT_EQ(x.settle_window, y.settle_window);
@@ -145,6 +149,10 @@ identification:
   cubic_correction: false
   instruments: regressor
   max_std_error: 0.2
+  guard: false
+  guard_threshold: 50
+  guard_min_shift: 0.002
+  guard_recent_time: 90
   min_excitation: 0.5
   settle_window: 2
   settle_tolerance: 0.02
@@ -180,6 +188,10 @@ service:
   EXPECT_FALSE(c.identification.cubic_correction);
   EXPECT_EQ(c.identification.instruments, Instruments::kRegressor);
   EXPECT_EQ(c.identification.max_std_error, 0.2);
+  EXPECT_FALSE(c.identification.guard);
+  EXPECT_EQ(c.identification.guard_threshold, 50.0);
+  EXPECT_EQ(c.identification.guard_min_shift, 0.002);
+  EXPECT_EQ(c.identification.guard_recent_time, 90.0);
   EXPECT_EQ(c.isolation.second_fault_time, 3.5);
   EXPECT_EQ(c.isolation.resume_after_fault, 4.5);
 }

@@ -179,7 +179,8 @@ TEST_P(DremProperty, EachEstimateConvergesMonotonically) {
     const Mat2 A = random_stable_A(rng);
     IdentificationParams p = params_for(GetParam(), rng);
     p.a0 = Vec4(3.0, -3.0, 3.0, 3.0);
-    const Data d = make_data(rng, A, p.eps1, 50.0, p.warmup_time + 25.0);
+    // (data enter the memory once judged: up to one and a half windows, 7.5 / eps1, late)
+    const Data d = make_data(rng, A, p.eps1, 50.0, p.warmup_time + 25.0 + 7.5 / p.eps1);
     Identifier id(p, d.B);
     const Vec4 a = to_params(A);
     Vec4 err_prev = (p.a0 - a).cwiseAbs();

@@ -235,6 +235,7 @@ class Isolator {
   double t_last_suspect_ = -1e300;
   double t_last_fault_ = -1e300;
   bool freeze_ = false;
+  bool data_inconsistent_ = false;  ///< identification's guard keeps the latest data out
   bool scales_configured_ = false;
   std::array<std::deque<std::pair<double, double>>, 2> hist_s_;  ///< (t, whitened structured)
   std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
