@@ -80,6 +80,8 @@ echo "      (usv-fdi sim --publish: INS and rudder samples, noise-free as in the
 timeout 300 "$exe" sim --publish --mmsi "$mmsi" --vessel otter --scenario paper --noise-scale 0 \
   --speed "$speed" --reliable --linger 0.5 "${dds[@]}" 2>"$out/sim.log"
 sleep 1.5  # the sidecar notices the silence after 1 s: both channels stale
+echo "   (the voyage is over: the INS falls silent, and after 1 s the sidecar raises both"
+echo "    channels as stale, as it would for a dead INS at sea)"
 echo
 echo "== 4. what the sidecar logged"
 grep -E "fault event|no INS sample" "$out/sidecar.log" | sed 's/^usv-fdi: [a-z]*: /   /'
