@@ -50,6 +50,7 @@
 #include <exception>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -59,6 +60,8 @@
 
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastdds/dds/log/StdoutErrConsumer.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
@@ -458,6 +461,16 @@ int writer_qos(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // stdout carries the protocol lines the tests parse; Fast DDS's own log (which by default
+  // writes to stdout from its logging thread, and can leave a line half written when ours is
+  // printed) goes to stderr, every kind of it.
+  {
+    namespace fdds = eprosima::fastdds::dds;
+    auto consumer = std::make_unique<fdds::StdoutErrConsumer>();
+    consumer->stderr_threshold(fdds::Log::Kind::Info);
+    fdds::Log::ClearConsumers();
+    fdds::Log::RegisterConsumer(std::move(consumer));
+  }
   try {
     const Options o = parse(argc, argv);
     if (o.mode == "writer-qos") return writer_qos(o);

@@ -35,6 +35,7 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -44,6 +45,8 @@
 
 #include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/core/status/StatusMask.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastdds/dds/log/StdoutErrConsumer.hpp>
 
 #include "usv_fdi/dds/dds_context.hpp"
 #include "usv_fdi/dds/profiles.hpp"
@@ -331,6 +334,16 @@ void install_signal_handlers() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // stdout carries the protocol lines the tests parse; Fast DDS's own log (which by default
+  // writes to stdout from its logging thread, and can leave a line half written when ours is
+  // printed) goes to stderr, every kind of it.
+  {
+    namespace fdds = eprosima::fastdds::dds;
+    auto consumer = std::make_unique<fdds::StdoutErrConsumer>();
+    consumer->stderr_threshold(fdds::Log::Kind::Info);
+    fdds::Log::ClearConsumers();
+    fdds::Log::RegisterConsumer(std::move(consumer));
+  }
   try {
     const Options o = parse(argc, argv);
     install_signal_handlers();
