@@ -2,6 +2,8 @@
 // RELIABLE + TRANSIENT_LOCAL, KEEP_LAST 1 per instance, sized for a fleet (4096 instances),
 // so on start it receives the latched state of every fault instance of every vessel.
 // With --ack it acknowledges an event and waits for the sidecar's confirmation.
+// It always reads FdiStatus too (printed with --status): every sample of a vessel updates its
+// "last heard" time, and a vessel not heard for --silent-after s is flagged silent on a timer.
 #include <spdlog/spdlog.h>
 
 #include <fastdds/dds/core/condition/WaitSet.hpp>
@@ -25,6 +27,7 @@
 #include "usv_fdi/dds_service/convert.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/jsonl.hpp"
+#include "vessel_liveness.hpp"
 
 namespace usvfdi::app {
 namespace {
@@ -44,14 +47,18 @@ struct MonitorArgs {
   double ack_timeout = 5.0;         ///< wait for the sidecar's confirmation of an ack [s]
   double discovery_timeout = 10.0;  ///< wait for a sidecar's ack reader [s]
   double duration = 0.0;            ///< stop after this long (0: until a signal)
-  bool once = false;  ///< print the latched state after --duration (default 3 s) and exit
-  int expect = 0;     ///< stop once this many instances are known
+  bool once = false;          ///< print the latched state after --duration (default 3 s) and exit
+  int expect = 0;             ///< stop once this many instances are known
+  double silent_after = 5.0;  ///< flag a vessel not heard for longer than this [s]
 };
 
 /// Wall-clock seconds since the epoch (the writer's source timestamps are on this clock).
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
+
+/// Monotonic seconds: the local receive times of "last heard".
+double mono_now() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
 struct Row {
   std::uint32_t mmsi = 0;
@@ -69,7 +76,7 @@ struct VesselStatus {
   fdds::InstanceHandle_t writer;
 };
 
-std::string json_row(const Row& r) {
+std::string json_row(const Row& r, double heard_age) {
   std::ostringstream os;
   const FaultEvent& e = r.ev;
   os << "{\"type\":\"fault\",\"mmsi\":" << r.mmsi << ",\"sensor\":\"" << to_string(e.sensor)
@@ -83,6 +90,7 @@ std::string json_row(const Row& r) {
      << io::json_number(e.A(0, 0)) << "," << io::json_number(e.A(0, 1)) << ","
      << io::json_number(e.A(1, 0)) << "," << io::json_number(e.A(1, 1))
      << "],\"age_s\":" << io::json_number(wall_now() - r.written)
+     << ",\"heard_age_s\":" << io::json_number(heard_age)
      << ",\"alive\":" << (r.alive ? "true" : "false")
      << ",\"message\":" << io::json_string(e.message) << "}";
   return os.str();
@@ -124,7 +132,7 @@ std::string inputs_line(const fdi::FdiStatus& s) {
   return line;
 }
 
-std::string json_status(const VesselStatus& v) {
+std::string json_status(const VesselStatus& v, double heard_age) {
   const fdi::FdiStatus& s = v.st;
   std::ostringstream os;
   os << "{\"type\":\"status\",\"mmsi\":" << s.mmsi() << ",\"stamp\":" << io::json_number(s.stamp())
@@ -143,13 +151,45 @@ std::string json_status(const VesselStatus& v) {
      << ",\"identification_paused\":" << json_names(pause_reason_names(s.identification_paused()))
      << ",\"isolation_paused\":" << json_names(pause_reason_names(s.isolation_paused()))
      << ",\"age_s\":" << io::json_number(wall_now() - v.written)
+     << ",\"heard_age_s\":" << io::json_number(heard_age)
      << ",\"alive\":" << (v.alive ? "true" : "false")
      << ",\"message\":" << io::json_string(s.message().to_string()) << "}";
   return os.str();
 }
 
+/// "vessel 257000001 (silent): last heard 7.2 s ago" (the start of a vessel's line).
+std::string heard_line(std::uint32_t mmsi, const VesselLiveness& live, bool gone) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "vessel %u%s%s: last heard %.1f s ago", mmsi,
+                gone ? " (sidecar gone)" : "", live.silent(mmsi) ? " (silent)" : "",
+                live.age(mmsi, mono_now()));
+  return buf;
+}
+
+/// The line printed once when a vessel goes silent or is heard again.
+std::string change_line(const VesselLiveness::Change& c, double silent_after) {
+  char buf[160];
+  if (c.silent) {
+    std::snprintf(buf, sizeof buf, "vessel %u silent: nothing heard for %.1f s (> %g s)", c.mmsi,
+                  c.age, silent_after);
+  } else {
+    std::snprintf(buf, sizeof buf, "vessel %u heard again after %.1f s of silence", c.mmsi, c.gap);
+  }
+  return buf;
+}
+
+std::string json_change(const VesselLiveness::Change& c, double silent_after) {
+  std::ostringstream os;
+  os << "{\"type\":\"vessel\",\"mmsi\":" << c.mmsi
+     << ",\"silent\":" << (c.silent ? "true" : "false")
+     << ",\"heard_age_s\":" << io::json_number(c.age);
+  if (!c.silent) os << ",\"gap_s\":" << io::json_number(c.gap);
+  os << ",\"silent_after_s\":" << io::json_number(silent_after) << "}";
+  return os.str();
+}
+
 void print_table(const std::map<RowKey, Row>& rows,
-                 const std::map<std::uint32_t, VesselStatus>* vessels) {
+                 const std::map<std::uint32_t, VesselStatus>* vessels, const VesselLiveness& live) {
   const double now = wall_now();
   std::printf("%-10s %-13s %-21s %-8s %5s %5s %4s %8s %8s %7s  %s\n", "VESSEL", "SENSOR", "STATE",
               "KIND", "C_A", "C_G", "SEQ", "ONSET[s]", "T[s]", "AGE[s]", "MESSAGE");
@@ -165,18 +205,29 @@ void print_table(const std::map<RowKey, Row>& rows,
               std::any_of(rows.begin(), rows.end(), [](const auto& kv) { return !kv.second.alive; })
                   ? "; '?': sidecar gone, last known state"
                   : "");
-  if (vessels != nullptr) {
-    for (const auto& [mmsi, v] : *vessels) {
-      const fdi::FdiStatus& s = v.st;
-      std::printf(
-          "vessel %u%s: t=%.1f s, %s%s, A=[%.4g %.4g; %.4g %.4g], %llu samples, %llu "
-          "dropped: %s\n",
-          mmsi, v.alive ? "" : " (sidecar gone)", s.stamp(),
-          s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0],
-          s.a()[1], s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
-          static_cast<unsigned long long>(s.dropped()), s.message().c_str());
-      std::printf("  %s\n", inputs_line(s).c_str());
+  // One line per vessel heard: how long ago; with --status also its FdiStatus.
+  for (const std::uint32_t mmsi : live.vessels()) {
+    const VesselStatus* vs = nullptr;
+    if (vessels != nullptr) {
+      const auto it = vessels->find(mmsi);
+      if (it != vessels->end()) vs = &it->second;
     }
+    if (vs == nullptr) {
+      const bool gone = std::any_of(rows.begin(), rows.end(), [&](const auto& kv) {
+        return kv.second.mmsi == mmsi && !kv.second.alive;
+      });
+      std::printf("%s\n", heard_line(mmsi, live, gone).c_str());
+      continue;
+    }
+    const fdi::FdiStatus& s = vs->st;
+    std::printf(
+        "%s; t=%.1f s, %s%s, A=[%.4g %.4g; %.4g %.4g], %llu samples, %llu "
+        "dropped: %s\n",
+        heard_line(mmsi, live, !vs->alive).c_str(), s.stamp(),
+        s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0], s.a()[1],
+        s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
+        static_cast<unsigned long long>(s.dropped()), s.message().c_str());
+    std::printf("  %s\n", inputs_line(s).c_str());
   }
   std::fflush(stdout);
 }
@@ -239,21 +290,20 @@ class GoneWriters : public fdds::DataReaderListener {
   std::vector<fdds::InstanceHandle_t> gone_, back_;
 };
 
-/// The FaultEvent (and optionally FdiStatus) side of the monitor.
+/// The FaultEvent and FdiStatus side of the monitor. The FdiStatus reader exists even without
+/// --status: the periodic status is what tells a quiet vessel from a silent one.
 class FleetView {
  public:
   FleetView(dds::DdsContext& ctx, const MonitorArgs& a)
-      : ctx_(ctx), a_(a), filter_(a.mmsi.begin(), a.mmsi.end()) {
+      : ctx_(ctx), a_(a), filter_(a.mmsi.begin(), a.mmsi.end()), live_(a.silent_after) {
     events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader,
                                  &events_gone_, fdds::StatusMask::subscription_matched());
     events_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
     ws_.attach_condition(events_->get_statuscondition());
-    if (a.status) {
-      status_ = &ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader,
-                                   &status_gone_, fdds::StatusMask::subscription_matched());
-      status_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
-      ws_.attach_condition(status_->get_statuscondition());
-    }
+    status_ = &ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader, &status_gone_,
+                                 fdds::StatusMask::subscription_matched());
+    status_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+    ws_.attach_condition(status_->get_statuscondition());
   }
   ~FleetView() {
     // The readers go before their listeners (a failure is logged by Fast DDS).
@@ -267,7 +317,8 @@ class FleetView {
   FleetView(const FleetView&) = delete;
   FleetView& operator=(const FleetView&) = delete;
 
-  /// Waits up to `timeout` for data; applies what arrived. Returns true if a row changed.
+  /// Waits up to `timeout` for data; applies what arrived, then flags the vessels that have
+  /// gone silent. Returns true if a row, a vessel status or a vessel's silence changed.
   bool poll(double timeout) {
     fdds::ConditionSeq active;
     ws_.wait(active, eprosima::fastrtps::Duration_t(timeout));
@@ -289,6 +340,7 @@ class FleetView {
         continue;
       }
       if (!filter_.empty() && !filter_.count(d.mmsi())) continue;
+      changed |= heard(d.mmsi());
       Row r;
       r.mmsi = d.mmsi();
       if (!service::from_dds(d, &r.ev)) {
@@ -304,29 +356,34 @@ class FleetView {
       changed = true;
       if (a_.json) emit_json(r);
     }
-    if (status_ != nullptr) {
+    {
       fdi::FdiStatus s;
       while (status_->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) {
           const auto it = status_handles_.find(info.instance_handle);
           if (it != status_handles_.end() && vessels_.count(it->second)) {
             vessels_[it->second].alive = false;
-            changed = true;
+            changed = a_.status || changed;
           }
           continue;
         }
         if (!filter_.empty() && !filter_.count(s.mmsi())) continue;
+        changed |= heard(s.mmsi());
         VesselStatus& v = vessels_[s.mmsi()];
         v.st = s;
         v.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
         v.writer = info.publication_handle;
         v.alive = true;
         status_handles_[info.instance_handle] = s.mmsi();
-        if (a_.json) {
-          std::printf("%s\n", json_status(v).c_str());
+        if (a_.json && a_.status) {
+          std::printf("%s\n", json_status(v, live_.age(s.mmsi(), mono_now())).c_str());
           std::fflush(stdout);
         }
       }
+    }
+    for (const VesselLiveness::Change& c : live_.evaluate(mono_now())) {
+      emit_change(c);
+      changed = true;
     }
     return changed;
   }
@@ -338,8 +395,11 @@ class FleetView {
   }
   const std::map<RowKey, Row>& rows() const { return rows_; }
   const std::map<std::uint32_t, VesselStatus>* vessels() const {
-    return status_ != nullptr ? &vessels_ : nullptr;
+    return a_.status ? &vessels_ : nullptr;
   }
+  const VesselLiveness& liveness() const { return live_; }
+  /// Seconds since anything was received from `mmsi` (NaN: never).
+  double heard_age(std::uint32_t mmsi) const { return live_.age(mmsi, mono_now()); }
 
  private:
   /// Flags the rows (and vessel statuses) whose writer is gone. Returns true if one changed.
@@ -356,23 +416,38 @@ class FleetView {
         }
       }
     }
-    if (status_ != nullptr) {
-      status_gone_.take(&gone, &back);
-      for (const auto& h : gone) {
-        for (auto& [m, v] : vessels_) {
-          if (v.writer == h && v.alive) {
-            v.alive = false;
-            changed = true;
-          }
+    status_gone_.take(&gone, &back);
+    for (const auto& h : gone) {
+      for (auto& [m, v] : vessels_) {
+        if (v.writer == h && v.alive) {
+          v.alive = false;
+          changed = a_.status || changed;
         }
       }
     }
     return changed;
   }
 
+  /// Records a sample received from `mmsi` now; prints "heard again" if it was silent.
+  bool heard(std::uint32_t mmsi) {
+    VesselLiveness::Change c;
+    if (!live_.heard(mmsi, mono_now(), &c)) return false;
+    emit_change(c);
+    return true;
+  }
+
+  /// Prints a vessel's change of silence once (not with --once: it prints the final state).
+  void emit_change(const VesselLiveness::Change& c) const {
+    if (a_.once) return;
+    const std::string line =
+        a_.json ? json_change(c, live_.silent_after()) : change_line(c, live_.silent_after());
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  }
+
   void emit_json(const Row& r) const {
     if (a_.once) return;  // --once prints the final state only
-    std::printf("%s\n", json_row(r).c_str());
+    std::printf("%s\n", json_row(r, live_.age(r.mmsi, mono_now())).c_str());
     std::fflush(stdout);
   }
 
@@ -387,6 +462,7 @@ class FleetView {
   std::map<fdds::InstanceHandle_t, RowKey> handles_;
   std::map<std::uint32_t, VesselStatus> vessels_;
   std::map<fdds::InstanceHandle_t, std::uint32_t> status_handles_;
+  VesselLiveness live_;
 };
 
 /// Why the sidecar will refuse an ack, judged from the latched state the monitor sees.
@@ -514,7 +590,7 @@ int run_monitor(const MonitorArgs& a) {
   for (;;) {
     const bool changed = view->poll(0.2);
     if (changed && !a.json && !a.once) {
-      print_table(view->rows(), view->vessels());
+      print_table(view->rows(), view->vessels(), view->liveness());
       printed = true;
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
@@ -523,16 +599,20 @@ int run_monitor(const MonitorArgs& a) {
   }
   if (a.once) {
     if (a.json) {
-      for (const auto& [key, r] : view->rows()) std::printf("%s\n", json_row(r).c_str());
+      for (const auto& [key, r] : view->rows()) {
+        std::printf("%s\n", json_row(r, view->heard_age(r.mmsi)).c_str());
+      }
       if (view->vessels() != nullptr) {
-        for (const auto& [m, v] : *view->vessels()) std::printf("%s\n", json_status(v).c_str());
+        for (const auto& [m, v] : *view->vessels()) {
+          std::printf("%s\n", json_status(v, view->heard_age(m)).c_str());
+        }
       }
       std::fflush(stdout);
     } else {
-      print_table(view->rows(), view->vessels());
+      print_table(view->rows(), view->vessels(), view->liveness());
     }
   } else if (!a.json && !printed) {
-    print_table(view->rows(), view->vessels());
+    print_table(view->rows(), view->vessels(), view->liveness());
   }
   if (a.expect > 0 && static_cast<int>(view->rows().size()) < a.expect) {
     spdlog::error("saw {} fault instances, expected {}", view->rows().size(), a.expect);
@@ -574,6 +654,12 @@ void register_monitor_command(CommandRegistry& registry) {
                 "wait --duration (default 3 s) for the latched state, print it once, exit");
   sub->add_option("--expect", args.expect, "exit 0 once this many fault instances are known")
       ->check(CLI::NonNegativeNumber);
+  sub->add_option("--silent-after", args.silent_after,
+                  "flag a vessel silent when nothing (status or fault event) has been received "
+                  "from it for this long [s]; printed once when it goes silent and when it is "
+                  "heard again")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 }
 
 }  // namespace usvfdi::app

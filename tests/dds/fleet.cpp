@@ -31,7 +31,8 @@ std::string slurp(const std::string& path) {
 }  // namespace
 
 bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,
-                        std::vector<MonitorStatus>* statuses, std::string* error) {
+                        std::vector<MonitorStatus>* statuses, std::string* error,
+                        std::vector<MonitorVessel>* vessels) {
   if (line.empty() || line[0] != '{') return true;
   try {
     const js::Value v = js::Parser(line).parse_document();
@@ -49,6 +50,7 @@ bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* even
       e.stamp = v.at("stamp").num;
       e.sequence = static_cast<unsigned long long>(v.at("sequence").num);
       e.alive = v.at("alive").b;
+      e.heard_age_s = v.at("heard_age_s").num;
       if (events != nullptr) events->push_back(e);
     } else if (type == "status") {
       MonitorStatus s;
@@ -74,7 +76,16 @@ bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* even
       s.gaps = count("gaps");
       s.reordered = count("reordered");
       s.dropped_inputs = count("dropped_inputs");
+      s.heard_age_s = v.at("heard_age_s").num;
       if (statuses != nullptr) statuses->push_back(s);
+    } else if (type == "vessel") {
+      MonitorVessel m;
+      m.mmsi = static_cast<unsigned>(v.at("mmsi").num);
+      m.silent = v.at("silent").b;
+      m.heard_age_s = v.at("heard_age_s").num;
+      if (!m.silent) m.gap_s = v.at("gap_s").num;
+      m.silent_after_s = v.at("silent_after_s").num;
+      if (vessels != nullptr) vessels->push_back(m);
     }
   } catch (const std::exception& e) {
     *error = e.what();

@@ -21,6 +21,7 @@ struct MonitorEvent {
   double c_a = 0, c_g = 0, onset_time = 0, detection_time = 0, stamp = 0;
   unsigned long long sequence = 0;
   bool alive = true;
+  double heard_age_s = -1;  ///< seconds since the monitor last received anything from the vessel
 };
 
 /// One FdiStatus as printed by `usv-fdi monitor --json --status`.
@@ -32,13 +33,22 @@ struct MonitorStatus {
   std::vector<std::string> input_flags, identification_paused, isolation_paused;
   unsigned long long rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
                      dropped_inputs = 0;
+  double heard_age_s = -1;
   bool has_flag(const std::string& f) const;
   static bool has(const std::vector<std::string>& v, const std::string& f);
 };
 
+/// A change of a vessel's silence as printed by `usv-fdi monitor --json` ("type":"vessel").
+struct MonitorVessel {
+  unsigned mmsi = 0;
+  bool silent = false;
+  double heard_age_s = -1, gap_s = -1, silent_after_s = -1;
+};
+
 /// Parses monitor --json lines (others are ignored); returns false on a malformed JSON line.
 bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,
-                        std::vector<MonitorStatus>* statuses, std::string* error);
+                        std::vector<MonitorStatus>* statuses, std::string* error,
+                        std::vector<MonitorVessel>* vessels = nullptr);
 
 class Fleet {
  public:

@@ -453,6 +453,120 @@ INSTANTIATE_TEST_SUITE_P(Signals, ShutdownUnderLoad, ::testing::Values(SIGTERM, 
                            return std::string(info.param == SIGTERM ? "sigterm" : "sigint");
                          });
 
+// ------------------------------------------------------------------ silent vessel
+
+/// What one `monitor --json` printed so far.
+struct MonitorOutput {
+  std::vector<MonitorEvent> events;
+  std::vector<MonitorStatus> statuses;
+  std::vector<MonitorVessel> vessels;
+  std::vector<std::string> lines;
+};
+
+/// Reads `monitor`'s lines into `out` until `done(out)` holds or `timeout` elapses.
+template <class Done>
+bool read_until(ChildProcess& monitor, MonitorOutput* out, std::chrono::milliseconds timeout,
+                Done done) {
+  const auto deadline = Clock::now() + timeout;
+  while (!done(*out)) {
+    const auto left = std::chrono::duration_cast<milliseconds>(deadline - Clock::now());
+    if (left.count() <= 0) return false;
+    const auto line = monitor.read_line(left);
+    if (!line) return false;
+    out->lines.push_back(*line);
+    std::string err;
+    if (!parse_monitor_line(*line, &out->events, &out->statuses, &err, &out->vessels)) {
+      ADD_FAILURE() << "malformed monitor line: " << err << ": " << *line;
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string joined(const MonitorOutput& o) {
+  std::string s;
+  for (const auto& l : o.lines) s += l + "\n";
+  return s;
+}
+
+TEST(ServiceEndToEnd, AStoppedSidecarIsReportedSilentLongBeforeItsLeaseExpiresAndHeardAgain) {
+  // GIVEN a sidecar (status_rate 5, no INS: it only publishes its status) and two monitors
+  // flagging a vessel silent after 2 s, one with --status, one showing fault events only
+  Fleet f;
+  const unsigned m = 257100011;
+  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60"});
+  ChildProcess& with_status =
+      f.start("mon_status", {"monitor", "--json", "--status", "--silent-after", "2"});
+  ChildProcess& events_only = f.start("mon_events", {"monitor", "--json", "--silent-after", "2"});
+  ChildProcess& svc = f.start_service("svc", cfg, 2);
+  // WHEN the monitors have heard its status for a while
+  MonitorOutput a, b;
+  ASSERT_TRUE(read_until(with_status, &a, seconds(20),
+                         [&](const MonitorOutput& o) { return o.statuses.size() >= 5; }))
+      << joined(a) << f.log("mon_status");
+  for (const auto& s : a.statuses) {
+    EXPECT_EQ(s.mmsi, m);
+    EXPECT_GE(s.heard_age_s, 0.0);
+    EXPECT_LT(s.heard_age_s, 1.0) << "printed as it arrives";
+  }
+  // AND the sidecar's process is stopped (its participant stays matched: lease 20 s)
+  svc.signal(SIGSTOP);
+  const auto t_stop = Clock::now();
+  // THEN both monitors report it silent, once, within a few seconds, while nothing arrives
+  const auto silent = [&](const MonitorOutput& o) {
+    return std::any_of(o.vessels.begin(), o.vessels.end(),
+                       [&](const MonitorVessel& v) { return v.mmsi == m && v.silent; });
+  };
+  const bool a_silent = read_until(with_status, &a, seconds(10), silent);
+  const double took = std::chrono::duration<double>(Clock::now() - t_stop).count();
+  const bool b_silent = read_until(events_only, &b, seconds(10), silent);
+  if (!a_silent || !b_silent) svc.signal(SIGCONT);
+  ASSERT_TRUE(a_silent) << joined(a) << f.log("mon_status");
+  ASSERT_TRUE(b_silent) << joined(b) << f.log("mon_events");
+  std::printf("stopped sidecar reported silent after %.2f s (--silent-after 2)\n", took);
+  EXPECT_LT(took, 10.0);
+  for (const MonitorOutput* o : {&a, &b}) {
+    ASSERT_EQ(o->vessels.size(), 1u) << joined(*o);
+    EXPECT_GT(o->vessels[0].heard_age_s, 2.0) << joined(*o);
+    EXPECT_LT(o->vessels[0].heard_age_s, 5.0) << joined(*o);
+    EXPECT_EQ(o->vessels[0].silent_after_s, 2.0);
+    // the sidecar's writer is not "gone": its lease has not expired
+    for (const auto& e : o->events) EXPECT_TRUE(e.alive) << joined(*o);
+  }
+  // WHEN the sidecar continues, after at least 3 s of silence
+  while (std::chrono::duration<double>(Clock::now() - t_stop).count() < 3.0) {
+    std::this_thread::sleep_for(milliseconds(50));
+  }
+  svc.signal(SIGCONT);
+  // THEN both monitors report it heard again, once, with the length of the silence, and
+  // statuses arrive fresh again
+  const auto heard = [&](const MonitorOutput& o) {
+    return std::any_of(o.vessels.begin(), o.vessels.end(),
+                       [&](const MonitorVessel& v) { return v.mmsi == m && !v.silent; });
+  };
+  ASSERT_TRUE(read_until(with_status, &a, seconds(10), heard)) << joined(a);
+  ASSERT_TRUE(read_until(events_only, &b, seconds(10), heard)) << joined(b);
+  for (const MonitorOutput* o : {&a, &b}) {
+    ASSERT_EQ(o->vessels.size(), 2u) << joined(*o);
+    EXPECT_FALSE(o->vessels[1].silent);
+    EXPECT_GE(o->vessels[1].gap_s, 3.0) << joined(*o);
+    EXPECT_LT(o->vessels[1].heard_age_s, 1.0) << joined(*o);
+  }
+  const std::size_t before = a.statuses.size();
+  ASSERT_TRUE(read_until(with_status, &a, seconds(10), [&](const MonitorOutput& o) {
+    return o.statuses.size() >= before + 3;
+  })) << joined(a);
+  EXPECT_LT(a.statuses.back().heard_age_s, 1.0);
+  EXPECT_EQ(a.vessels.size(), 2u) << "no new silence\n" << joined(a);
+  // AND the table shows how long ago the vessel was heard
+  std::string table;
+  const auto code =
+      f.run_to_end("table", {"monitor", "--once", "--duration", "2"}, seconds(15), &table);
+  ASSERT_TRUE(code.has_value() && *code == 0) << f.log("table");
+  EXPECT_NE(table.find("vessel " + std::to_string(m) + ": last heard "), std::string::npos)
+      << table;
+}
+
 // ------------------------------------------------------------------ bad input
 
 TEST(ServiceCli, BadConfigurationsAreRefusedWithTheirReason) {

@@ -35,10 +35,19 @@ struct StatusUpdate {
   double received = 0.0;
 };
 
+/// A vessel going silent (nothing received for --silent-after) or heard again.
+struct VesselChange {
+  unsigned mmsi = 0;
+  bool silent = false;
+  double heard_age_s = 0.0;
+  double received = 0.0;
+};
+
 /// Everything a monitor printed, in order.
 struct MonitorLog {
   std::vector<FaultUpdate> faults;
   std::vector<StatusUpdate> statuses;
+  std::vector<VesselChange> vessels;
   std::vector<std::string> other;  ///< lines that are not JSON objects (there should be none)
 
   /// Parses one stdout line; throws std::runtime_error on a malformed JSON line.
@@ -81,6 +90,13 @@ struct MonitorLog {
       s.dropped = static_cast<unsigned long long>(v.at("dropped").num);
       s.received = received;
       statuses.push_back(s);
+    } else if (type == "vessel") {
+      VesselChange c;
+      c.mmsi = static_cast<unsigned>(v.at("mmsi").num);
+      c.silent = v.at("silent").b;
+      c.heard_age_s = v.at("heard_age_s").num;
+      c.received = received;
+      vessels.push_back(c);
     } else {
       other.push_back(line);
     }

@@ -543,6 +543,21 @@ void partition_test(bool longer_than_lease) {
     }
   }
   EXPECT_GT(control_statuses, 0u) << "the control vessel's status stopped too\n" << ctx;
+  // The monitor flagged vessel 1 silent during the cut (nothing heard for --silent-after, 5 s:
+  // the cut lasts ~10 s), without waiting for the lease, and heard again after the heal, each
+  // once; the control vessel was never silent.
+  std::vector<VesselChange> silence1;
+  for (const auto& c : mon.vessels) {
+    if (c.mmsi == m1) silence1.push_back(c);
+    EXPECT_NE(c.mmsi, m2) << "the control vessel went silent\n" << ctx;
+  }
+  ASSERT_EQ(silence1.size(), 2u) << ctx;
+  EXPECT_TRUE(silence1[0].silent) << ctx;
+  EXPECT_GT(silence1[0].heard_age_s, 5.0) << ctx;
+  EXPECT_GT(silence1[0].received, t_cut) << ctx;
+  EXPECT_FALSE(silence1[1].silent) << ctx;
+  EXPECT_GT(silence1[1].received, t_heal) << ctx;
+  const double silent_at = silence1[0].received - t_cut, heard_at = silence1[1].received - t_heal;
   if (longer_than_lease) {
     // The shore declared vessel 1's sidecar gone after its lease (2 s), and showed the latched
     // state again after the heal: the gyro event (#2, unchanged) once more, identical.
@@ -557,13 +572,14 @@ void partition_test(bool longer_than_lease) {
   std::printf(
       "partition %s the lease: cut at %.2f s, %s, healed at %.2f s (%.2f s cut); last status "
       "of vessel 1 at %.2f s, first after the heal %.2f s (+%.2f s), first event after the heal "
-      "+%.2f s; %d event(s) shown again after the heal; control: %u statuses during the cut\n",
+      "+%.2f s; %d event(s) shown again after the heal; control: %u statuses during the cut; "
+      "vessel 1 flagged silent at +%.2f s after the cut, heard again +%.2f s after the heal\n",
       longer_than_lease ? "longer than" : "shorter than", t_cut,
       gone_at > 0
           ? ("shore flagged the vessel gone at +" + std::to_string(gone_at - t_cut) + " s").c_str()
           : "shore never flagged the vessel gone",
       t_heal, t_heal - t_cut, last_status_before, first_status_after, first_status_after - t_heal,
-      first_after_heal - t_heal, repeats, control_statuses);
+      first_after_heal - t_heal, repeats, control_statuses, silent_at, heard_at);
 }
 
 TEST(FleetPartition, ShorterThanTheLeaseRepairedByReliableResend) { partition_test(false); }
