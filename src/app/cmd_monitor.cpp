@@ -96,20 +96,6 @@ std::string json_row(const Row& r, double heard_age) {
   return os.str();
 }
 
-/// ["a","b"] from a comma-separated list of names.
-std::string json_names(const std::string& names) {
-  std::string out = "[";
-  std::size_t start = 0;
-  while (start < names.size()) {
-    std::size_t end = names.find(',', start);
-    if (end == std::string::npos) end = names.size();
-    if (out.size() > 1) out += ",";
-    out += io::json_string(names.substr(start, end - start));
-    start = end + 1;
-  }
-  return out + "]";
-}
-
 /// One line on the inputs of a vessel: problems, counters, pauses.
 std::string inputs_line(const fdi::FdiStatus& s) {
   std::string flags = input_flag_names(s.input_flags());
@@ -144,12 +130,13 @@ std::string json_status(const VesselStatus& v, double heard_age) {
      << ",\"ins_healthy\":" << (s.ins_healthy() ? "true" : "false")
      << ",\"rudder_healthy\":" << (s.rudder_healthy() ? "true" : "false")
      << ",\"samples\":" << s.samples() << ",\"dropped\":" << s.dropped()
-     << ",\"input_flags\":" << json_names(input_flag_names(s.input_flags()))
+     << ",\"input_flags\":" << io::json_string_array(input_flag_names(s.input_flags()))
      << ",\"rejected_timestamps\":" << s.rejected_timestamps()
      << ",\"invalid_values\":" << s.invalid_values() << ",\"gaps\":" << s.gaps()
      << ",\"reordered\":" << s.reordered() << ",\"dropped_inputs\":" << s.dropped_inputs()
-     << ",\"identification_paused\":" << json_names(pause_reason_names(s.identification_paused()))
-     << ",\"isolation_paused\":" << json_names(pause_reason_names(s.isolation_paused()))
+     << ",\"identification_paused\":"
+     << io::json_string_array(pause_reason_names(s.identification_paused()))
+     << ",\"isolation_paused\":" << io::json_string_array(pause_reason_names(s.isolation_paused()))
      << ",\"age_s\":" << io::json_number(wall_now() - v.written)
      << ",\"heard_age_s\":" << io::json_number(heard_age)
      << ",\"alive\":" << (v.alive ? "true" : "false")

@@ -25,19 +25,6 @@ std::string num(double x) {
   return buf;
 }
 
-std::string names_json(const std::string& names) {
-  std::string out = "[";
-  std::size_t start = 0;
-  while (start < names.size()) {
-    std::size_t end = names.find(',', start);
-    if (end == std::string::npos) end = names.size();
-    if (out.size() > 1) out += ", ";
-    out += io::json_string(names.substr(start, end - start));
-    start = end + 1;
-  }
-  return out + "]";
-}
-
 std::string fixed(const char* format, double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, x);
@@ -76,9 +63,11 @@ std::string health_json(const HealthReport& r) {
      << ", \"rudder_age\": " << (r.live.rudder_age < 0 ? "null" : num(r.live.rudder_age))
      << ", \"samples\": " << r.samples << ", \"converged\": " << (r.converged ? "true" : "false")
      << ", \"armed\": " << (r.armed ? "true" : "false")
-     << ", \"input_flags\": " << names_json(input_flag_names(r.input_flags))
-     << ", \"identification_paused\": " << names_json(pause_reason_names(r.identification_paused))
-     << ", \"isolation_paused\": " << names_json(pause_reason_names(r.isolation_paused))
+     << ", \"input_flags\": " << io::json_string_array(input_flag_names(r.input_flags), ", ")
+     << ", \"identification_paused\": "
+     << io::json_string_array(pause_reason_names(r.identification_paused), ", ")
+     << ", \"isolation_paused\": "
+     << io::json_string_array(pause_reason_names(r.isolation_paused), ", ")
      << ", \"dropped\": " << r.dropped << ", \"fault_event_readers\": " << r.fault_event_readers
      << ", \"state_file\": " << io::json_string(r.state_file)
      << ", \"state_error\": " << io::json_string(r.state_error) << "}\n";

@@ -98,6 +98,19 @@ std::string json_string(const std::string& s) {
   return o;
 }
 
+std::string json_string_array(const std::string& names, const char* separator) {
+  std::string out = "[";
+  std::size_t start = 0;
+  while (start < names.size()) {
+    std::size_t end = names.find(',', start);
+    if (end == std::string::npos) end = names.size();
+    if (out.size() > 1) out += separator;
+    out += json_string(names.substr(start, end - start));
+    start = end + 1;
+  }
+  return out + "]";
+}
+
 std::string json_number(double x) {
   if (!std::isfinite(x)) return "null";
   char buf[32];

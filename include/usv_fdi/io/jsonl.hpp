@@ -26,6 +26,9 @@ namespace usvfdi::io {
 std::string json_string(const std::string& s);
 /// A JSON number with %.9g, or null when x is not finite.
 std::string json_number(double x);
+/// A JSON array of strings from a comma-separated list of names ("a,b" -> ["a","b"]; "" -> []),
+/// the elements separated by `separator`.
+std::string json_string_array(const std::string& names, const char* separator = ",");
 
 /// What a replay did (the summary record).
 struct RunSummary {
