@@ -75,4 +75,15 @@ bool parse_fault_kind(const std::string& text, FaultKind* out) {
   return false;
 }
 
+bool parse_fault_state(const std::string& text, FaultState* out) {
+  for (int i = 0; i <= static_cast<int>(FaultState::kAcknowledged); ++i) {
+    const auto s = static_cast<FaultState>(i);
+    if (text == to_string(s)) {
+      *out = s;
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace usvfdi

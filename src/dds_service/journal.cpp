@@ -45,17 +45,6 @@ std::string number(double x) {
   return buf;
 }
 
-bool parse_state(const std::string& text, FaultState* out) {
-  for (int i = 0; i <= static_cast<int>(FaultState::kAcknowledged); ++i) {
-    const auto s = static_cast<FaultState>(i);
-    if (text == to_string(s)) {
-      *out = s;
-      return true;
-    }
-  }
-  return false;
-}
-
 struct Bad : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -108,7 +97,7 @@ FaultEvent instance(const YAML::Node& n) {
   const std::string sensor = text(need(n, "sensor", ctx), "sensor");
   if (!parse_sensor(sensor, &e.sensor)) throw Bad(ctx + ": unknown sensor \"" + sensor + "\"");
   const std::string state = text(need(n, "state", ctx), "state");
-  if (!parse_state(state, &e.state)) throw Bad(ctx + ": unknown state \"" + state + "\"");
+  if (!parse_fault_state(state, &e.state)) throw Bad(ctx + ": unknown state \"" + state + "\"");
   const std::string kind = text(need(n, "kind", ctx), "kind");
   if (!parse_fault_kind(kind, &e.kind)) throw Bad(ctx + ": unknown kind \"" + kind + "\"");
   e.sequence = integer(need(n, "sequence", ctx), "sequence");

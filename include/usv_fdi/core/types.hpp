@@ -59,6 +59,7 @@ const char* to_string(FaultKind k);
 const char* to_string(FaultState s);
 bool parse_sensor(const std::string& text, Sensor* out);
 bool parse_fault_kind(const std::string& text, FaultKind* out);
+bool parse_fault_state(const std::string& text, FaultState* out);
 
 /// Row-major A as [a1 a2 a3 a4].
 inline Vec4 to_params(const Mat2& A) { return Vec4(A(0, 0), A(0, 1), A(1, 0), A(1, 1)); }
