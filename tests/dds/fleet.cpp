@@ -94,6 +94,14 @@ bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* even
   return true;
 }
 
+std::vector<std::string> sim_args(const std::vector<std::string>& extra) {
+  std::vector<std::string> a = {"sim",   "--publish",     "--vessel", "otter",      "--scenario",
+                                "paper", "--noise-scale", "0",        "--reliable", "--linger",
+                                "0.2"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
 bool MonitorStatus::has(const std::vector<std::string>& v, const std::string& f) {
   return std::find(v.begin(), v.end(), f) != v.end();
 }

@@ -50,6 +50,10 @@ bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* even
                         std::vector<MonitorStatus>* statuses, std::string* error,
                         std::vector<MonitorVessel>* vessels = nullptr);
 
+/// `usv-fdi sim --publish` of the paper's scenario on the Otter, noise-free, RELIABLE, with a
+/// short linger, followed by `extra`.
+std::vector<std::string> sim_args(const std::vector<std::string>& extra);
+
 class Fleet {
  public:
   /// Creates a private directory for configs and logs, a domain id and a partition.

@@ -34,14 +34,6 @@ using std::chrono::milliseconds;
 using std::chrono::seconds;
 using Clock = std::chrono::steady_clock;
 
-std::vector<std::string> sim_args(const std::vector<std::string>& extra) {
-  std::vector<std::string> a = {"sim",   "--publish",     "--vessel", "otter",      "--scenario",
-                                "paper", "--noise-scale", "0",        "--reliable", "--linger",
-                                "0.2"};
-  a.insert(a.end(), extra.begin(), extra.end());
-  return a;
-}
-
 std::string dump(const std::vector<MonitorEvent>& all) {
   std::string s;
   for (const auto& e : all) {

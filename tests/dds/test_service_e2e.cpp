@@ -102,14 +102,6 @@ long long number_before(const std::string& text, const std::string& suffix) {
   return std::stoll(text.substr(begin, at - begin));
 }
 
-std::vector<std::string> sim_args(const std::vector<std::string>& extra) {
-  std::vector<std::string> a = {"sim",   "--publish",     "--vessel", "otter",      "--scenario",
-                                "paper", "--noise-scale", "0",        "--reliable", "--linger",
-                                "0.2"};
-  a.insert(a.end(), extra.begin(), extra.end());
-  return a;
-}
-
 // ------------------------------------------------------------------ paper scenario
 
 TEST(ServiceEndToEnd, PaperScenarioRaisesIsolatesAndClearsBothFaults) {
