@@ -8,6 +8,7 @@
 
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/sim/hulls.hpp"
+#include "usv_fdi/sim/manoeuvre.hpp"
 
 namespace usvfdi::sim {
 namespace {
@@ -47,6 +48,33 @@ TEST(VesselsCli, YamlLoadsWithTheConfigLoaderAndCarriesTheLinearisedB) {
       }
     }
   }
+}
+
+TEST(VesselsCli, ReplayRunsWithThePrintedConfigurationOnTheHullsOwnZigzag) {
+  // GIVEN the configuration printed for the course-unstable KVLCC2 and a 10/10 zigzag of
+  // that hull at 10 Hz written as the CSV replay reads
+  const std::string dir = ::testing::TempDir();
+  std::string yaml;
+  ASSERT_EQ(run("vessels --yaml kvlcc2", &yaml), 0);
+  std::ofstream(dir + "kvlcc2.yaml") << yaml;
+  const Hull& h = *find_hull("kvlcc2")->hull;
+  std::ofstream csv(dir + "kvlcc2_zigzag.csv");
+  csv << "t,v,r,delta\n";
+  ManoeuvreState s;
+  s.x.u = h.nominal_speed();
+  const double sign = starboard_rudder_sign(h, s.x.u), d = 10 * M_PI / 180;
+  double side = 1.0;
+  for (int k = 0; k < 1200; ++k) {
+    if (side * s.psi >= d) side = -side;
+    csv << 0.1 * k << "," << s.x.v << "," << s.x.r << "," << s.delta << "\n";
+    for (int i = 0; i < 5; ++i) s = manoeuvre_step(h, s, sign * side * d, 1.0, 0.02);
+  }
+  csv.close();
+  // WHEN usv-fdi replay runs it THEN it accepts the configuration and writes its summary
+  std::string out;
+  ASSERT_EQ(
+      run("replay --config " + dir + "kvlcc2.yaml --input " + dir + "kvlcc2_zigzag.csv", &out), 0);
+  EXPECT_NE(out.find("\"summary\""), std::string::npos) << out.substr(0, 400);
 }
 
 TEST(VesselsCli, YamlRefusesAnUnknownHullAndAnUnreachableSpeed) {
