@@ -279,9 +279,10 @@ TEST(Manoeuvre, RudderServoHonoursSaturationAndRateLimit) {
 
 // --- The recorded KVLCC2 zigzags (HSVA, SIMMAN 2008) ----------------------------------
 
+/// The shared data directory: $USV_FDI_SHARED, else ../shared beside the source tree.
 std::string shared_dir() {
   const char* env = std::getenv("USV_FDI_SHARED");
-  return env != nullptr ? env : USV_FDI_SHARED_DIR;
+  return env != nullptr ? env : std::string(USV_FDI_SOURCE_DIR) + "/../shared";
 }
 
 /// Heading [rad] column of an HSVA csv, relative to its first value; empty if unreadable.
