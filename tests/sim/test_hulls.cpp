@@ -91,6 +91,16 @@ TEST(Zoo, CoversSlowShipsCourseUnstableShipsAndUnstableUsvs) {
   EXPECT_FALSE(stable(linearise(hull("otter3dof"), 3.0).A));
 }
 
+TEST(Zoo, TheEssoTankerIsCourseUnstableLoadedInDeepWaterAsItsTrialsFound) {
+  // Full-scale trials of the 193 000 dwt Esso Bernicia (Clarke, Patterson & Wooderson 1973,
+  // Trans. RINA, pp. 89-109): course-unstable in all conditions except deep-water ballast.
+  // The van Berlekom & Goddard model of that tanker size, loaded, in deep water:
+  for (double U : {8.23, 5.0}) {
+    const Linearisation l = linearise(hull("esso-tanker"), U);
+    EXPECT_LT(l.A.determinant(), 0.0) << U;  // one positive real eigenvalue
+  }
+}
+
 // --- Linearisation --------------------------------------------------------------------
 
 TEST(Linearise, AgreesWithFiniteDifferencesAtOtherStepSizes) {
