@@ -66,7 +66,7 @@ int list_zoo() {
   std::printf("\nshipped linear models of usv-fdi sim --vessel (with their INS noise):\n");
   for (const VesselModel& m : shipped_vessels()) {
     std::printf(
-        "  %-8s u0 %.6g m/s, B [%.6g, %.6g], sigma_v %.3g m/s, sigma_r %.3g rad/s, "
+        "  %-8s u0 %.6g m/s, B: [%.6g, %.6g], sigma_v %.3g m/s, sigma_r %.3g rad/s, "
         "config/vessels/%s.yaml\n",
         m.name.c_str(), m.u0, m.B(0), m.B(1), m.sigma_v, m.sigma_r, m.name.c_str());
   }
