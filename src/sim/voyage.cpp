@@ -46,7 +46,10 @@ void check_config(const Hull& hull, const VoyageConfig& c) {
 }
 
 /// PID gains from the first-order Nomoto approximation T r' + r = K delta of the
-/// linearisation (T = K / b2): Kp = wn^2 / b2, Kd = 2 zeta wn / b2 - 1 / K.
+/// linearisation (K = num / det(A), T = T1 + T2 - T3 with T1 + T2 = -tr(A) / det(A) and
+/// T3 = b2 / num, num = a3 b1 - a1 b2): Kp = T wn^2 / K, Kd = (2 zeta wn T - 1) / K, written
+/// with T / K = -tr / num - b2 det / num^2 so that det(A) = 0 (a marginally stable hull) and
+/// det(A) < 0 (course-unstable: T < 0) need no special case.
 struct Gains {
   double kp = 0.0, kd = 0.0, ki = 0.0, wn = 0.0;
 };
@@ -56,11 +59,14 @@ Gains autopilot_gains(const Linearisation& lin, const AutopilotConfig& a, const 
   g.wn = a.bandwidth > 0 ? a.bandwidth : 1.2 * hull.nominal_speed() / hull.limits().length;
   const Mat2& A = lin.A;
   const double b1 = lin.B(0), b2 = lin.B(1);
-  if (b2 == 0.0) throw std::invalid_argument("voyage (" + hull.name() + "): the rudder has no yaw effect");
-  const double num = A(1, 0) * b1 - A(0, 0) * b2;  // K det(A)
-  const double inv_k = num != 0.0 ? A.determinant() / num : 0.0;
-  g.kp = g.wn * g.wn / b2;
-  g.kd = 2.0 * a.damping * g.wn / b2 - inv_k;
+  const double num = A(1, 0) * b1 - A(0, 0) * b2;
+  if (num == 0.0) {
+    throw std::invalid_argument("voyage (" + hull.name() + "): the rudder makes no steady turn");
+  }
+  const double t_over_k = -A.trace() / num - b2 * A.determinant() / (num * num);
+  const double inv_k = A.determinant() / num;
+  g.kp = g.wn * g.wn * t_over_k;
+  g.kd = 2.0 * a.damping * g.wn * t_over_k - inv_k;
   g.ki = a.integral * g.wn * g.kp;
   return g;
 }
@@ -180,7 +186,7 @@ void Voyage::Impl::start_leg(std::size_t i) {
   steering_open = g.kind == Manoeuvre::kZigzag || g.kind == Manoeuvre::kTurn;
   leg_base = steering_open ? psi_hat : target;
   zig_side = sign_of(g.rudder);
-  integral = 0.0;
+  if (steering_open) integral = 0.0;  // the autopilot is disengaged: it starts afresh after
   if (g.kind == Manoeuvre::kCourse) target += g.heading;
 }
 

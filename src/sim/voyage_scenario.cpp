@@ -72,6 +72,20 @@ const char* to_string(Manoeuvre m) {
   return "hold";
 }
 
+double turning_rudder(const Hull& hull) {
+  const double full = std::min(35.0 * kDeg, hull.limits().max_rudder);
+  if (hull.nonlinear()) return full;
+  // A linear hull has no nonlinear damping to bound its turn: at 35 deg its steady yaw rate
+  // K delta is far beyond any real ship's. Use the rudder that gives a turning circle of
+  // diameter 4 L (r = U0 / 2L), a typical tactical diameter of a hard-over turn.
+  const Linearisation lin = linearise_fd(hull);
+  const double det = lin.A.determinant();
+  const double num = lin.A(1, 0) * lin.B(0) - lin.A(0, 0) * lin.B(1);
+  if (!(det > 0) || num == 0.0) return full;
+  const double r = hull.nominal_speed() / (2.0 * hull.limits().length);
+  return std::min(full, r / std::abs(num / det));
+}
+
 double leg_period(const Hull& hull) {
   const double u0 = hull.nominal_speed(), l = hull.limits().length;
   return std::max(20.0, 6.0 * l / u0);
@@ -83,7 +97,7 @@ std::vector<std::string> scenario_names() {
 
 std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull) {
   const double p = leg_period(hull);
-  const double turn_rudder = std::min(35.0 * kDeg, hull.limits().max_rudder);
+  const double turn_rudder = turning_rudder(hull);
   std::vector<Leg> out;
   if (name == "hold") {
     out.push_back(leg(Manoeuvre::kHold, p));

@@ -194,6 +194,14 @@ TEST(Voyage, TurningCirclesTurnFullCirclesAndResumeTheCourse) {
     const auto rows = run_voyage(h, c);
     const auto legs = legs_of(rows, Manoeuvre::kTurn);
     ASSERT_GE(legs.size(), 2u) << name;
+    // on a linear hull with the rudder of a circle of diameter 4 L
+    const double r_ss = h->nominal_speed() / (2 * h->limits().length);
+    double r_max = 0;
+    for (std::size_t i = legs[0].first; i < legs[0].second; ++i) {
+      r_max = std::max(r_max, std::abs(rows[i].r_lf));
+      EXPECT_NEAR(std::abs(rows[i].delta_cmd), turning_rudder(*h), 1e-12);
+    }
+    EXPECT_NEAR(r_max, r_ss, 0.15 * r_ss) << name;
     // THEN each turn ends after 360 deg (starboard first, then port)
     for (int j = 0; j < 2; ++j) {
       const double turned = rows[legs[j].second - 1].psi_meas - rows[legs[j].first].psi_meas;
@@ -268,16 +276,21 @@ TEST(Voyage, RudderIsSaturatedAndRateLimited) {
 }
 
 TEST(Voyage, DitherAddsASineToTheRudderCommand) {
-  const auto h = hull("otter");
-  VoyageConfig c = base(*h, "hold", 100);
+  // (the Mariner: her heading loop is far slower than a 10 s dither)
+  const auto h = hull("mariner");
+  VoyageConfig c = base(*h, "hold", 1000);
   sensor_preset("ideal", 0, 0, &c.sensors);
   const auto plain = run_voyage(h, c);
   c.autopilot.dither = 0.5 * kDeg;
   c.autopilot.dither_period = 10;
   const auto dithered = run_voyage(h, c);
-  double amp = 0;
-  for (const VoyageRow& w : dithered) amp = std::max(amp, std::abs(w.delta_cmd));
-  EXPECT_NEAR(amp, 0.5 * kDeg, 0.1 * kDeg);  // calm, noise-free: the dither alone
+  // THEN the command carries a sine of the dither period (the autopilot answers the yaw it
+  // makes, so less than the dither itself), and without dither nothing moves
+  double corr = 0;
+  for (const VoyageRow& w : dithered) corr += w.delta_cmd * std::sin(2 * M_PI * w.t_true / 10);
+  const double amp = 2 * corr / static_cast<double>(dithered.size());
+  EXPECT_GT(amp, 0.4 * kDeg);
+  EXPECT_LT(amp, 0.55 * kDeg);
   for (const VoyageRow& w : plain) EXPECT_LT(std::abs(w.delta_cmd), 1e-9);
 }
 

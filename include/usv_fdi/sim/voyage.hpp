@@ -55,6 +55,9 @@ std::vector<std::string> scenario_names();
 std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull);
 /// Time between course changes of the scripted voyages: max(20 s, 6 L / U0).
 double leg_period(const Hull& hull);
+/// Rudder of the turning circles: 35 deg (or the hull's maximum); on a linear hull, whose
+/// steady turn at 35 deg no real ship reaches, the rudder of a circle of diameter 4 L.
+double turning_rudder(const Hull& hull);
 
 // -------------------------------------------------------------------------- environment
 
