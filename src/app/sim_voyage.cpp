@@ -165,10 +165,10 @@ bool VoyageArgs::any() const {
          !fault_set.empty() || !sigma_faults.empty() || !dither.empty();
 }
 
-std::vector<std::string> voyage_vessel_names() { return sim::linear_hull_names(); }
+std::vector<std::string> voyage_vessel_names() { return sim::voyage_hull_names(); }
 
 std::shared_ptr<const sim::Hull> find_voyage_hull(const std::string& name) {
-  return sim::make_linear_hull(name);
+  return sim::voyage_hull(name);
 }
 
 void add_voyage_options(CLI::App* sub, VoyageArgs* a) {

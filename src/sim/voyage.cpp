@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "usv_fdi/sim/hulls.hpp"
 #include "voyage_internal.hpp"
 
 namespace usvfdi::sim {
@@ -70,27 +71,16 @@ Gains autopilot_gains(const Linearisation& lin, const AutopilotConfig& a, const 
   g.ki = a.integral * g.wn * g.kp;
   return g;
 }
-}  // namespace
 
-Linearisation linearise_fd(const Hull& hull) {
-  Linearisation lin;
-  lin.u0 = hull.nominal_speed();
-  const double hv = 1e-4 * lin.u0, hr = hv / hull.limits().length, hd = 1e-4;
-  const auto f = [&](double v, double r, double d) {
-    HullState x;
-    x.u = lin.u0;
-    x.v = v;
-    x.r = r;
-    HullInput in;
-    in.delta = d;
-    const HullRates k = hull.rates(x, in, Disturbance{});
-    return Vec2(k.dv, k.dr);
-  };
-  lin.A.col(0) = (f(hv, 0, 0) - f(-hv, 0, 0)) / (2 * hv);
-  lin.A.col(1) = (f(0, hr, 0) - f(0, -hr, 0)) / (2 * hr);
-  lin.B = (f(0, 0, hd) - f(0, 0, -hd)) / (2 * hd);
-  return lin;
+
+Linearisation linearise_nominal(const Hull& hull) {
+  try {
+    return linearise(hull, hull.nominal_speed());
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument("voyage (" + hull.name() + "): " + e.what());
+  }
 }
+}  // namespace
 
 struct Voyage::Impl {
   Impl(std::shared_ptr<const Hull> h, const VoyageConfig& cfg);
@@ -130,7 +120,7 @@ Voyage::Impl::Impl(std::shared_ptr<const Hull> hl, const VoyageConfig& cfg)
     : hull(std::move(hl)),
       c(cfg),
       lim(hull->limits()),
-      lin(linearise_fd(*hull)),
+      lin(linearise_nominal(*hull)),
       gains(autopilot_gains(lin, cfg.autopilot, *hull)),
       h(1.0 / cfg.rate_hz),
       env(cfg.environment, lin, lim.length, 1.0 / cfg.rate_hz, cfg.seed),

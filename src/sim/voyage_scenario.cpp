@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "usv_fdi/sim/hulls.hpp"
 #include "voyage_internal.hpp"
 
 namespace usvfdi::sim {
@@ -78,7 +79,7 @@ double turning_rudder(const Hull& hull) {
   // A linear hull has no nonlinear damping to bound its turn: at 35 deg its steady yaw rate
   // K delta is far beyond any real ship's. Use the rudder that gives a turning circle of
   // diameter 4 L (r = U0 / 2L), a typical tactical diameter of a hard-over turn.
-  const Linearisation lin = linearise_fd(hull);
+  const Linearisation lin = linearise(hull, hull.nominal_speed());
   const double det = lin.A.determinant();
   const double num = lin.A(1, 0) * lin.B(0) - lin.A(0, 0) * lin.B(1);
   if (!(det > 0) || num == 0.0) return full;

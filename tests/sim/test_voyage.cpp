@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "usv_fdi/sim/hulls.hpp"
 #include "usv_fdi/sim/voyage.hpp"
 
 namespace usvfdi::sim {
@@ -19,7 +20,7 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 std::shared_ptr<const Hull> hull(const std::string& name) {
-  auto h = make_linear_hull(name);
+  auto h = voyage_hull(name);
   if (!h) throw std::runtime_error("no hull " + name);
   return h;
 }
@@ -102,7 +103,7 @@ TEST(Voyage, SameSeedGivesTheSameRowsAndAnotherSeedDoesNot) {
 
 TEST(Voyage, SwitchingOnOneProcessLeavesTheOthersStreamsAlone) {
   // GIVEN the same voyage without and with a current
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "hold", 200);
   c.environment.sea = sea_state(3);
   const auto calm = run_voyage(h, c);
@@ -119,7 +120,7 @@ TEST(Voyage, SwitchingOnOneProcessLeavesTheOthersStreamsAlone) {
 // ----------------------------------------------------------------- autopilot, manoeuvres
 
 TEST(Voyage, AutopilotHoldsTheCourseOnTheMeasuredHeading) {
-  for (const std::string name : {"mariner", "otter"}) {
+  for (const std::string name : {"mariner-linear", "otter"}) {
     // GIVEN a noisy straight passage with a wind and a current
     const auto h = hull(name);
     VoyageConfig c = base(*h, "hold", 30 * leg_period(*h));
@@ -138,7 +139,7 @@ TEST(Voyage, AutopilotHoldsTheCourseOnTheMeasuredHeading) {
 }
 
 TEST(Voyage, CourseChangesReachEachNewCourse) {
-  for (const std::string name : {"mariner", "otter"}) {
+  for (const std::string name : {"mariner-linear", "otter"}) {
     // GIVEN the course scenario (+10, -10, -10, +10 deg)
     const auto h = hull(name);
     VoyageConfig c = base(*h, "course", 5 * leg_period(*h));
@@ -160,7 +161,7 @@ TEST(Voyage, CourseChangesReachEachNewCourse) {
 
 TEST(Voyage, ZigzagsSwitchTheRudderAtTheHeadingAndOvershoot) {
   for (const double angle : {10.0, 20.0}) {
-    for (const std::string name : {"mariner", "otter"}) {
+    for (const std::string name : {"mariner-linear", "otter"}) {
       // GIVEN a zigzag angle/angle
       const auto h = hull(name);
       const std::string sc = angle == 10.0 ? "zigzag10" : "zigzag20";
@@ -188,7 +189,7 @@ TEST(Voyage, ZigzagsSwitchTheRudderAtTheHeadingAndOvershoot) {
 }
 
 TEST(Voyage, TurningCirclesTurnFullCirclesAndResumeTheCourse) {
-  for (const std::string name : {"mariner", "otter"}) {
+  for (const std::string name : {"mariner-linear", "otter"}) {
     const auto h = hull(name);
     VoyageConfig c = base(*h, "turn", 2000 + 12 * leg_period(*h));
     const auto rows = run_voyage(h, c);
@@ -218,7 +219,7 @@ TEST(Voyage, TurningCirclesTurnFullCirclesAndResumeTheCourse) {
 }
 
 TEST(Voyage, SpeedChangesChangeTheSurgeSpeed) {
-  for (const std::string name : {"mariner", "otter"}) {
+  for (const std::string name : {"mariner-linear", "otter"}) {
     // GIVEN throttle steps 0.7, 1.0, 1.3, 1.0, each held for 3 leg periods
     const auto h = hull(name);
     const double p = leg_period(*h), u0 = h->nominal_speed();
@@ -264,7 +265,7 @@ TEST(Voyage, TheAutopilotFeedsBackTheMeasuredYawRate) {
 }
 
 TEST(Voyage, RudderIsSaturatedAndRateLimited) {
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "turn", 600);
   const auto rows = run_voyage(h, c);
   const HullLimits l = h->limits();
@@ -277,7 +278,7 @@ TEST(Voyage, RudderIsSaturatedAndRateLimited) {
 
 TEST(Voyage, DitherAddsASineToTheRudderCommand) {
   // (the Mariner: her heading loop is far slower than a 10 s dither)
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "hold", 1000);
   sensor_preset("ideal", 0, 0, &c.sensors);
   const auto plain = run_voyage(h, c);
@@ -299,7 +300,7 @@ TEST(Voyage, DitherAddsASineToTheRudderCommand) {
 TEST(Voyage, WaveMotionHasTheSpectrumsPeakPeriodAndVariance) {
   for (const int code : {3, 4, 5}) {
     // GIVEN a straight passage in sea state code
-    const auto h = hull("mariner");
+    const auto h = hull("mariner-linear");
     VoyageConfig c = base(*h, "hold", 7200);
     const SeaState sea = sea_state(code);
     c.environment.sea = sea;
@@ -344,7 +345,7 @@ TEST(Voyage, HigherSeaStatesMoveTheHullMore) {
 }
 
 TEST(Voyage, WindIsASlowlyVaryingSwayForceAndYawMoment) {
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "hold", 2000);
   c.environment.wind = 1 * kDeg;
   c.environment.wind_sigma = 0.5 * kDeg;
@@ -354,7 +355,7 @@ TEST(Voyage, WindIsASlowlyVaryingSwayForceAndYawMoment) {
     dr.push_back(w.dist_r);
     dv.push_back(w.dist_v);
   }
-  const Linearisation lin = linearise_fd(*h);
+  const Linearisation lin = linearise(*h, h->nominal_speed());
   // the rudder's split of force and moment, gusts of 0.5 deg around 1 deg
   EXPECT_NEAR(dv[500] / dr[500], lin.B(0) / lin.B(1), 1e-9);
   EXPECT_NEAR(mean(dr) / lin.B(1), 1 * kDeg, 0.3 * kDeg);
@@ -365,7 +366,7 @@ TEST(Voyage, WindIsASlowlyVaryingSwayForceAndYawMoment) {
 
 TEST(Voyage, ACurrentMovesTheHullOverGroundWithoutTurningIt) {
   // GIVEN a noise-free straight passage in a beam current of 0.5 m/s
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "hold", 600);
   sensor_preset("ideal", 0, 0, &c.sensors);
   c.environment.current = 0.5;
@@ -429,7 +430,7 @@ TEST(Voyage, QuantisationStepsAreAsSpecified) {
 
 TEST(Voyage, GaussMarkovNoiseHasTheConfiguredVarianceAndCorrelationTime) {
   // GIVEN a gyro with GM noise only (sigma 3e-4 rad/s, tau 2 s) at 2 Hz
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "hold", 20000, 2.0);
   c.sensors.r = ChannelNoise{};
   c.sensors.r.gm_sigma = 3e-4;
@@ -445,7 +446,7 @@ TEST(Voyage, GaussMarkovNoiseHasTheConfiguredVarianceAndCorrelationTime) {
 }
 
 TEST(Voyage, GyroBiasInstabilityIsARandomWalk) {
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   VoyageConfig c = base(*h, "hold", 5000, 10.0);
   c.sensors.r.bias_rw = 2e-5;
   const auto rows = run_voyage(h, c);
@@ -616,7 +617,7 @@ TEST(Voyage, FaultMagnitudesFollowTheChannelSigma) {
 // ------------------------------------------------------------------------- hulls, csv
 
 TEST(LinearHull, AScalesWithSpeedAndBWithItsSquare) {
-  const auto h = hull("mariner");
+  const auto h = hull("mariner-linear");
   HullState x;
   x.u = h->nominal_speed();
   x.v = 0.1;
@@ -634,10 +635,10 @@ TEST(LinearHull, AScalesWithSpeedAndBWithItsSquare) {
   const HullRates b2 = h->rates(x0, in, Disturbance{});
   EXPECT_NEAR(b2.dr, 0.25 * b1.dr, 1e-15);
   EXPECT_NEAR(f2.dr - b2.dr, 0.5 * (f1.dr - b1.dr), 1e-15);
-  const Linearisation lin = linearise_fd(*h);
+  const Linearisation lin = linearise(*h, h->nominal_speed());
   EXPECT_NEAR(lin.A(1, 1), -0.100362, 1e-9);
   EXPECT_NEAR(lin.B(1), -3.74282e-3, 1e-12);
-  EXPECT_EQ(make_linear_hull("titanic"), nullptr);
+  EXPECT_EQ(voyage_hull("titanic"), nullptr);
 }
 
 TEST(VoyageCsv, KeepsTheSimRowColumnsFirstAndTheSurgeSpeedAsU) {

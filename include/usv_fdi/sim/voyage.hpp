@@ -199,7 +199,7 @@ class Voyage {
   /// The next emitted row (dropped samples are skipped, duplicates repeated); false once
   /// the duration is over.
   bool next(VoyageRow* row);
-  /// The hull's finite-difference linearisation about straight running at U0.
+  /// The hull's linearisation about straight running at its nominal speed (sim::linearise).
   const Linearisation& linearisation() const;
 
  private:
@@ -210,14 +210,12 @@ class Voyage {
 /// Runs a whole voyage.
 std::vector<VoyageRow> run_voyage(std::shared_ptr<const Hull> hull, const VoyageConfig& cfg);
 
-/// The shipped vessels (core: mariner L = 160.93 m, otter L = 2.0 m) as linear hulls
-/// (A ~ U/U0, B ~ (U/U0)^2, first-order surge; src/sim/linear_hull.hpp).
-std::vector<std::string> linear_hull_names();
-/// Returns nullptr when there is no shipped vessel of that name.
-std::shared_ptr<const Hull> make_linear_hull(const std::string& name);
-
-/// Linearises hull.rates about straight running at its nominal speed by central differences.
-Linearisation linearise_fd(const Hull& hull);
+/// Every hull a voyage can drive: the vessel zoo (usv_fdi/sim/hulls.hpp), then the core's
+/// shipped vessels the zoo has no entry of that name for (otter: a linear hull with A ~ U/U0,
+/// B ~ (U/U0)^2 and a first-order surge).
+std::vector<std::string> voyage_hull_names();
+/// Returns nullptr when there is no hull of that name.
+std::shared_ptr<const Hull> voyage_hull(const std::string& name);
 
 /// CSV of voyage rows: the SimRow columns first (t,v,r,delta,v_true,r_true,delta_true,psi,
 /// psi_ref,fault_a,fault_g), then u,t_true,v_lf,r_lf,v_wave,r_wave,v_current,psi_meas,delta_cmd,
