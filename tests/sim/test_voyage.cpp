@@ -295,6 +295,41 @@ TEST(Voyage, DitherAddsASineToTheRudderCommand) {
   for (const VoyageRow& w : plain) EXPECT_LT(std::abs(w.delta_cmd), 1e-9);
 }
 
+TEST(Voyage, EveryZooHullHoldsItsCoursesAndFollowsTheThrottle) {
+  for (const std::string& name : voyage_hull_names()) {
+    // GIVEN the hull under course changes and under throttle steps
+    const auto h = hull(name);
+    const double p = leg_period(*h);
+    VoyageConfig c = base(*h, "course", 5 * p, 5.0);
+    const auto rows = run_voyage(h, c);
+    // THEN every sample is finite and each course is reached within 1.5 deg by the leg's end
+    for (const VoyageRow& w : rows) ASSERT_TRUE(std::isfinite(w.psi + w.u_true + w.v + w.r)) << name;
+    for (int j = 0; j < 4; ++j) {
+      const auto it = std::find_if(rows.begin(), rows.end(), [&](const VoyageRow& w) {
+        return w.t_true >= (j + 2) * p - 1.0;
+      });
+      ASSERT_NE(it, rows.end());
+      EXPECT_NEAR(it->psi, it->psi_ref, 1.5 * kDeg) << name << " leg " << j;
+    }
+    // AND the surge speed goes down with -30 % throttle and up with +30 %
+    c = base(*h, "speed", 13 * p, 5.0);
+    const auto sp = run_voyage(h, c);
+    double u_end[4] = {0, 0, 0, 0};
+    for (int j = 0; j < 4; ++j) {
+      const double t_end = (1 + 3 * (j + 1)) * p - 1.0;
+      const auto it = std::find_if(sp.begin(), sp.end(),
+                                   [&](const VoyageRow& w) { return w.t_true >= t_end; });
+      ASSERT_NE(it, sp.end());
+      u_end[j] = it->u_true;
+    }
+    const double u0 = h->nominal_speed();
+    EXPECT_LT(u_end[0], 0.9 * u0) << name;
+    EXPECT_NEAR(u_end[1], u0, 0.05 * u0) << name;
+    EXPECT_GT(u_end[2], 1.1 * u0) << name;
+    EXPECT_NEAR(u_end[3], u0, 0.05 * u0) << name;
+  }
+}
+
 // ---------------------------------------------------------------------------- waves
 
 TEST(Voyage, WaveMotionHasTheSpectrumsPeakPeriodAndVariance) {
