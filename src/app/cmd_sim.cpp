@@ -113,15 +113,18 @@ int run_sim(const SimArgs& a) {
   if (!is_classic(a.scenario)) return run_voyage_scenario(a);
   VesselModel vessel;
   if (!find_vessel(a.vessel, &vessel)) {
-    spdlog::error("--vessel '{}': the classic scenarios (paper, healthy, faults) run the shipped "
-                  "vessels only; give a voyage scenario (--scenario course, voyage, ...)",
-                  a.vessel);
+    spdlog::error(
+        "--vessel '{}': the classic scenarios (paper, healthy, faults) run the shipped "
+        "vessels only; give a voyage scenario (--scenario course, voyage, ...)",
+        a.vessel);
     return kExitUsage;
   }
   if (a.voyage.any()) {
-    spdlog::error("--sea-state, --current, --wind, --sensor, --fault-set, --fault-sigma and "
-                  "--dither need a voyage scenario (course, zigzag10, zigzag20, turn, speed, "
-                  "slow, voyage, hold), not '{}'", a.scenario);
+    spdlog::error(
+        "--sea-state, --current, --wind, --sensor, --fault-set, --fault-sigma and "
+        "--dither need a voyage scenario (course, zigzag10, zigzag20, turn, speed, "
+        "slow, voyage, hold), not '{}'",
+        a.scenario);
     return kExitUsage;
   }
   SimConfig c;

@@ -174,7 +174,8 @@ std::shared_ptr<const sim::Hull> find_voyage_hull(const std::string& name) {
 void add_voyage_options(CLI::App* sub, VoyageArgs* a) {
   sub->add_option("--sea-state", a->sea_state,
                   "voyages: first-order wave motion of sea state 0 (calm), 3, 4, 5 or 6");
-  sub->add_option("--wave-period", a->wave_period, "voyages: peak period [s] (default: the sea state's)")
+  sub->add_option("--wave-period", a->wave_period,
+                  "voyages: peak period [s] (default: the sea state's)")
       ->check(CLI::Range(2.0, 30.0));
   sub->add_option("--current", a->current,
                   "voyages: current SPEED[:SET_DEG] [m/s], slowly varying (20 % Gauss-Markov, "

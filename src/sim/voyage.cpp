@@ -72,7 +72,6 @@ Gains autopilot_gains(const Linearisation& lin, const AutopilotConfig& a, const 
   return g;
 }
 
-
 Linearisation linearise_nominal(const Hull& hull) {
   try {
     return linearise(hull, hull.nominal_speed());
@@ -196,16 +195,16 @@ double Voyage::Impl::autopilot() {
   double d = g * (gains.kp * e - gains.kd * r_last + gains.ki * integral);
   const double cap = 0.3 * lim.max_rudder;  // anti-windup: the integral holds at most 30 %
   if (std::abs(d) < lim.max_rudder && gains.ki != 0.0) {
-    integral = std::clamp(integral + e * h, -cap / std::abs(g * gains.ki),
-                          cap / std::abs(g * gains.ki));
+    integral =
+        std::clamp(integral + e * h, -cap / std::abs(g * gains.ki), cap / std::abs(g * gains.ki));
   }
   return d;
 }
 
 double Voyage::Impl::command(double t) {
-  const double dither =
-      c.autopilot.dither > 0 ? c.autopilot.dither * std::sin(2 * kPi * t / c.autopilot.dither_period)
-                             : 0.0;
+  const double dither = c.autopilot.dither > 0
+                            ? c.autopilot.dither * std::sin(2 * kPi * t / c.autopilot.dither_period)
+                            : 0.0;
   double d = 0.0;
   const Leg* g = c.legs.empty() ? nullptr : &c.legs[leg];
   if (g != nullptr && g->kind == Manoeuvre::kZigzag) {
@@ -240,7 +239,8 @@ void Voyage::Impl::measure(VoyageRow* row) {
   const double v = ch_v.measure(row->v_true), r = ch_r.measure(row->r_true);
   row->v = c.sensors.v.quantiser.apply(
       faults.apply(Sensor::kAccelerometer, t, row->v_true, v, &row->fault_a));
-  row->r = c.sensors.r.quantiser.apply(faults.apply(Sensor::kGyro, t, row->r_true, r, &row->fault_g));
+  row->r =
+      c.sensors.r.quantiser.apply(faults.apply(Sensor::kGyro, t, row->r_true, r, &row->fault_g));
   row->delta = c.sensors.delta.quantiser.apply(ch_d.measure(row->delta_true));
   row->gyro_bias = ch_r.bias();
   const Disturbance d = env.disturbance();
@@ -250,9 +250,8 @@ void Voyage::Impl::measure(VoyageRow* row) {
 
 void Voyage::Impl::update_heading(const VoyageRow& row) {
   // The autopilot's heading: the measured yaw rate integrated, pulled towards the compass.
-  const double compass = row.psi + (c.sensors.compass_sigma > 0
-                                        ? c.sensors.compass_sigma * s_compass.normal()
-                                        : 0.0);
+  const double compass =
+      row.psi + (c.sensors.compass_sigma > 0 ? c.sensors.compass_sigma * s_compass.normal() : 0.0);
   const bool r_ok = std::isfinite(row.r);
   if (k == 0 || !(c.sensors.compass_tau > 0)) {
     psi_hat = compass;
@@ -276,9 +275,8 @@ bool Voyage::Impl::produce(VoyageRow* row) {
   row->throttle = throttle;
   row->manoeuvre = c.legs.empty() ? Manoeuvre::kHold : c.legs[leg].kind;
   const double jmax = 0.45 * h;
-  row->t = t + (c.sensors.jitter > 0
-                    ? std::clamp(c.sensors.jitter * s_link.normal(), -jmax, jmax)
-                    : 0.0);
+  row->t = t + (c.sensors.jitter > 0 ? std::clamp(c.sensors.jitter * s_link.normal(), -jmax, jmax)
+                                     : 0.0);
   advance();
   ++k;
   return true;
@@ -336,8 +334,8 @@ void VoyageCsvWriter::write(const VoyageRow& w) {
                 "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s,%d\n",
                 w.t, w.v, w.r, w.delta, w.v_true, w.r_true, w.delta_true, w.psi, w.psi_ref,
                 kind(w.fault_a), kind(w.fault_g), w.u_true, w.t_true, w.v_lf, w.r_lf, w.v_wave,
-                w.r_wave, w.v_current, w.psi_meas, w.delta_cmd, w.throttle, w.gyro_bias, w.dist_v, w.dist_r,
-                to_string(w.manoeuvre), w.duplicate ? 1 : 0);
+                w.r_wave, w.v_current, w.psi_meas, w.delta_cmd, w.throttle, w.gyro_bias, w.dist_v,
+                w.dist_r, to_string(w.manoeuvre), w.duplicate ? 1 : 0);
   out_ << buf;
 }
 

@@ -31,12 +31,18 @@ SeaState sea_state(int code) {
   // Hs: the middle of the WMO sea state code's range; Tp: the most probable modal period
   // of the open North Atlantic for that code, as commonly tabulated (NATO STANAG 4194).
   switch (code) {
-    case 0: return {0, 0.0, 0.0};
-    case 3: return {3, 0.875, 7.5};
-    case 4: return {4, 1.875, 8.8};
-    case 5: return {5, 3.25, 9.7};
-    case 6: return {6, 5.0, 12.4};
-    default: break;
+    case 0:
+      return {0, 0.0, 0.0};
+    case 3:
+      return {3, 0.875, 7.5};
+    case 4:
+      return {4, 1.875, 8.8};
+    case 5:
+      return {5, 3.25, 9.7};
+    case 6:
+      return {6, 5.0, 12.4};
+    default:
+      break;
   }
   throw std::invalid_argument("sea state " + std::to_string(code) +
                               ": expected 0 (calm), 3, 4, 5 or 6");
@@ -126,7 +132,8 @@ void Environment::step(double psi) {
   }
   gust_.step(&s_wind_);
   current_.step(&s_current_);
-  if (c_.current_direction_rw > 0) set_ += c_.current_direction_rw * std::sqrt(dt_) * s_current_.normal();
+  if (c_.current_direction_rw > 0)
+    set_ += c_.current_direction_rw * std::sqrt(dt_) * s_current_.normal();
   update_disturbance(psi);
 }
 

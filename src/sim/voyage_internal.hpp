@@ -70,8 +70,8 @@ void wave_sigmas(const SeaState& sea, double length, double* yaw_rate, double* s
 /// ground: the INS reads its cross component in the sway velocity.
 class Environment {
  public:
-  Environment(const EnvironmentConfig& c, const Linearisation& lin, double length,
-              double dt, std::uint64_t seed);
+  Environment(const EnvironmentConfig& c, const Linearisation& lin, double length, double dt,
+              std::uint64_t seed);
   /// Advances over one sample at the (true, low-frequency) heading psi.
   void step(double psi);
   double v_wave() const { return sway_.rate(); }

@@ -64,11 +64,16 @@ void slow_passage(double p, std::vector<Leg>* out) {
 
 const char* to_string(Manoeuvre m) {
   switch (m) {
-    case Manoeuvre::kHold: return "hold";
-    case Manoeuvre::kCourse: return "course";
-    case Manoeuvre::kZigzag: return "zigzag";
-    case Manoeuvre::kTurn: return "turn";
-    case Manoeuvre::kSpeed: return "speed";
+    case Manoeuvre::kHold:
+      return "hold";
+    case Manoeuvre::kCourse:
+      return "course";
+    case Manoeuvre::kZigzag:
+      return "zigzag";
+    case Manoeuvre::kTurn:
+      return "turn";
+    case Manoeuvre::kSpeed:
+      return "speed";
   }
   return "hold";
 }

@@ -34,32 +34,46 @@ ChannelNoise* channel_of(const std::string& name, SensorConfig* s) {
 
 bool set_channel(ChannelNoise* c, const std::string& field, double v, std::string* why) {
   const bool nonneg = v >= 0;
-  if (field == "white" && nonneg) c->white = v;
-  else if (field == "gm" && nonneg) c->gm_sigma = v;
-  else if (field == "gm_tau" && v > 0) c->gm_tau = v;
-  else if (field == "bias_rw" && nonneg) c->bias_rw = v;
-  else if (field == "bias") c->bias = v;
-  else if (field == "lag" && nonneg) c->lag = v;
-  else if (field == "step" && nonneg) c->quantiser.step = v;
+  if (field == "white" && nonneg)
+    c->white = v;
+  else if (field == "gm" && nonneg)
+    c->gm_sigma = v;
+  else if (field == "gm_tau" && v > 0)
+    c->gm_tau = v;
+  else if (field == "bias_rw" && nonneg)
+    c->bias_rw = v;
+  else if (field == "bias")
+    c->bias = v;
+  else if (field == "lag" && nonneg)
+    c->lag = v;
+  else if (field == "step" && nonneg)
+    c->quantiser.step = v;
   else if (field == "digits" && nonneg && v <= 17 && v == std::floor(v))
     c->quantiser.digits = static_cast<int>(v);
   else {
-    *why = "unknown field or value out of range (fields: white, gm, gm_tau, bias_rw, bias, "
-           "lag, step, digits; only bias may be negative, gm_tau > 0, digits 0..17)";
+    *why =
+        "unknown field or value out of range (fields: white, gm, gm_tau, bias_rw, bias, "
+        "lag, step, digits; only bias may be negative, gm_tau > 0, digits 0..17)";
     return false;
   }
   return true;
 }
 
 bool set_global(const std::string& key, double v, SensorConfig* s, std::string* why) {
-  if (key == "jitter" && v >= 0) s->jitter = v;
-  else if ((key == "drop") && v >= 0 && v < 1) s->drop = v;
-  else if ((key == "duplicate" || key == "dup") && v >= 0 && v < 1) s->duplicate = v;
-  else if (key == "compass" && v >= 0) s->compass_sigma = v;
-  else if (key == "compass_tau" && v >= 0) s->compass_tau = v;
+  if (key == "jitter" && v >= 0)
+    s->jitter = v;
+  else if ((key == "drop") && v >= 0 && v < 1)
+    s->drop = v;
+  else if ((key == "duplicate" || key == "dup") && v >= 0 && v < 1)
+    s->duplicate = v;
+  else if (key == "compass" && v >= 0)
+    s->compass_sigma = v;
+  else if (key == "compass_tau" && v >= 0)
+    s->compass_tau = v;
   else {
-    *why = "unknown key or value out of range (keys: jitter, drop, duplicate, compass, "
-           "compass_tau, rot=nmea, <channel>.<field> with channel acc|gyro|rudder)";
+    *why =
+        "unknown key or value out of range (keys: jitter, drop, duplicate, compass, "
+        "compass_tau, rot=nmea, <channel>.<field> with channel acc|gyro|rudder)";
     return false;
   }
   return true;
@@ -152,10 +166,10 @@ std::vector<FaultInjection> standard_faults(const VoyageConfig& cfg, double t0, 
     FaultKind kind;
     double k;
   };
-  const Kind kinds[] = {{FaultKind::kBias, 10.0},  {FaultKind::kStuck, 0.0},
+  const Kind kinds[] = {{FaultKind::kBias, 10.0},         {FaultKind::kStuck, 0.0},
                         {FaultKind::kDrift, 10.0 / 30.0}, {FaultKind::kNoise, std::sqrt(63.0)},
-                        {FaultKind::kScale, 0.5},  {FaultKind::kSpikes, 25.0},
-                        {FaultKind::kStale, 0.0},  {FaultKind::kInvalid, 0.0}};
+                        {FaultKind::kScale, 0.5},         {FaultKind::kSpikes, 25.0},
+                        {FaultKind::kStale, 0.0},         {FaultKind::kInvalid, 0.0}};
   std::vector<FaultInjection> out;
   double t = t0;
   for (int i = 0; t + length <= cfg.duration; ++i, t += length + gap) {
@@ -206,21 +220,28 @@ double Faults::apply(Sensor sensor, double t, double truth, double y, FaultKind*
 double Faults::apply_one(std::size_t i, double t, double truth, double y) {
   const FaultInjection& f = f_[i];
   switch (f.kind) {
-    case FaultKind::kBias: return y + f.magnitude;
-    case FaultKind::kDrift: return y + f.magnitude * (t - f.t_start);
-    case FaultKind::kNoise: return y + f.magnitude * s_.normal();
+    case FaultKind::kBias:
+      return y + f.magnitude;
+    case FaultKind::kDrift:
+      return y + f.magnitude * (t - f.t_start);
+    case FaultKind::kNoise:
+      return y + f.magnitude * s_.normal();
     case FaultKind::kSpikes: {
       const bool spike = s_.uniform() < f.spike_rate * dt_;
       const double sign = s_.uniform() < 0.5 ? -1.0 : 1.0;
       return spike ? y + sign * f.magnitude : y;
     }
-    case FaultKind::kScale: return y + f.magnitude * truth;
+    case FaultKind::kScale:
+      return y + f.magnitude * truth;
     case FaultKind::kStuck:
       if (std::isnan(held_[i])) held_[i] = y;
       return held_[i];
-    case FaultKind::kStale: return kNaN;
-    case FaultKind::kInvalid: return std::numeric_limits<double>::infinity();
-    case FaultKind::kUnknown: break;
+    case FaultKind::kStale:
+      return kNaN;
+    case FaultKind::kInvalid:
+      return std::numeric_limits<double>::infinity();
+    case FaultKind::kUnknown:
+      break;
   }
   return y;
 }

@@ -58,9 +58,9 @@ double autocorr(const std::vector<double>& x, std::size_t k) {
 
 bool same_row(const VoyageRow& a, const VoyageRow& b) {
   const auto eq = [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); };
-  return eq(a.t, b.t) && eq(a.v, b.v) && eq(a.r, b.r) && eq(a.delta, b.delta) &&
-         eq(a.psi, b.psi) && eq(a.u_true, b.u_true) && a.fault_a == b.fault_a &&
-         a.fault_g == b.fault_g && a.duplicate == b.duplicate;
+  return eq(a.t, b.t) && eq(a.v, b.v) && eq(a.r, b.r) && eq(a.delta, b.delta) && eq(a.psi, b.psi) &&
+         eq(a.u_true, b.u_true) && a.fault_a == b.fault_a && a.fault_g == b.fault_g &&
+         a.duplicate == b.duplicate;
 }
 
 /// Index ranges [first, last) of the rows of each leg of kind m.
@@ -210,7 +210,8 @@ TEST(Voyage, TurningCirclesTurnFullCirclesAndResumeTheCourse) {
       EXPECT_EQ(turned > 0, j == 0) << name;
       // and the autopilot takes her back onto the course (mod 360) within the next leg
       // (the hold leg of 2 leg periods after the turn)
-      const std::size_t end = legs[j].second + static_cast<std::size_t>(2 * leg_period(*h) * c.rate_hz) - 2;
+      const std::size_t end =
+          legs[j].second + static_cast<std::size_t>(2 * leg_period(*h) * c.rate_hz) - 2;
       ASSERT_LT(end, rows.size());
       EXPECT_EQ(rows[end].manoeuvre, Manoeuvre::kHold);
       EXPECT_NEAR(std::remainder(rows[end].psi, 2 * M_PI), 0.0, 2 * kDeg) << name << " turn " << j;
@@ -258,7 +259,8 @@ TEST(Voyage, TheAutopilotFeedsBackTheMeasuredYawRate) {
   double before = 0, after = 0;
   for (std::size_t i = 0; i < healthy.size(); ++i) {
     const double d = std::abs(healthy[i].delta_cmd - faulty[i].delta_cmd);
-    (healthy[i].t_true < 100 ? before : after) = std::max(d, healthy[i].t_true < 100 ? before : after);
+    (healthy[i].t_true < 100 ? before : after) =
+        std::max(d, healthy[i].t_true < 100 ? before : after);
   }
   EXPECT_EQ(before, 0.0);
   EXPECT_GT(after, 0.1 * kDeg);
@@ -303,7 +305,8 @@ TEST(Voyage, EveryZooHullHoldsItsCoursesAndFollowsTheThrottle) {
     VoyageConfig c = base(*h, "course", 5 * p, 5.0);
     const auto rows = run_voyage(h, c);
     // THEN every sample is finite and each course is reached within 1.5 deg by the leg's end
-    for (const VoyageRow& w : rows) ASSERT_TRUE(std::isfinite(w.psi + w.u_true + w.v + w.r)) << name;
+    for (const VoyageRow& w : rows)
+      ASSERT_TRUE(std::isfinite(w.psi + w.u_true + w.v + w.r)) << name;
     for (int j = 0; j < 4; ++j) {
       const auto it = std::find_if(rows.begin(), rows.end(), [&](const VoyageRow& w) {
         return w.t_true >= (j + 2) * p - 1.0;
@@ -317,8 +320,8 @@ TEST(Voyage, EveryZooHullHoldsItsCoursesAndFollowsTheThrottle) {
     double u_end[4] = {0, 0, 0, 0};
     for (int j = 0; j < 4; ++j) {
       const double t_end = (1 + 3 * (j + 1)) * p - 1.0;
-      const auto it = std::find_if(sp.begin(), sp.end(),
-                                   [&](const VoyageRow& w) { return w.t_true >= t_end; });
+      const auto it =
+          std::find_if(sp.begin(), sp.end(), [&](const VoyageRow& w) { return w.t_true >= t_end; });
       ASSERT_NE(it, sp.end());
       u_end[j] = it->u_true;
     }
@@ -486,7 +489,8 @@ TEST(Voyage, GyroBiasInstabilityIsARandomWalk) {
   c.sensors.r.bias_rw = 2e-5;
   const auto rows = run_voyage(h, c);
   std::vector<double> inc;
-  for (std::size_t i = 1; i < rows.size(); ++i) inc.push_back(rows[i].gyro_bias - rows[i - 1].gyro_bias);
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    inc.push_back(rows[i].gyro_bias - rows[i - 1].gyro_bias);
   EXPECT_NEAR(std::sqrt(variance(inc)), 2e-5 * std::sqrt(0.1), 0.03 * 2e-5 * std::sqrt(0.1));
   EXPECT_NEAR(autocorr(inc, 1), 0.0, 0.03);  // independent increments
 }
@@ -586,14 +590,18 @@ TEST(Voyage, StandardFaultsAppearWithTheirMagnitudeAndIntervalDuringManoeuvres) 
     const std::string what = std::string(to_string(f.sensor)) + " " + to_string(f.kind);
     // and each kind has its magnitude in sigma
     switch (f.kind) {
-      case FaultKind::kBias: EXPECT_NEAR(mean(err) / sigma, 10.0, 0.5) << what; break;
+      case FaultKind::kBias:
+        EXPECT_NEAR(mean(err) / sigma, 10.0, 0.5) << what;
+        break;
       case FaultKind::kDrift: {
         // the ramp reaches 10 sigma in 30 s: 20/3 sigma at the end of a 20 s interval
         EXPECT_NEAR(err.back() / sigma, 10.0 / 30.0 * (20.0 - 0.1), 3.5) << what;
         EXPECT_NEAR(err[err.size() / 2] / sigma, 10.0 / 30.0 * 10.0, 3.5) << what;
         break;
       }
-      case FaultKind::kNoise: EXPECT_NEAR(std::sqrt(variance(err)) / sigma, 8.0, 0.8) << what; break;
+      case FaultKind::kNoise:
+        EXPECT_NEAR(std::sqrt(variance(err)) / sigma, 8.0, 0.8) << what;
+        break;
       case FaultKind::kScale: {
         double num = 0, den = 0;
         for (std::size_t i = 0; i < err.size(); ++i) {
@@ -618,7 +626,9 @@ TEST(Voyage, StandardFaultsAppearWithTheirMagnitudeAndIntervalDuringManoeuvres) 
       case FaultKind::kInvalid:
         for (const double y : val) EXPECT_TRUE(std::isinf(y)) << what;
         break;
-      case FaultKind::kUnknown: ADD_FAILURE(); break;
+      case FaultKind::kUnknown:
+        ADD_FAILURE();
+        break;
     }
   }
   // and outside every interval of a sensor its column is empty

@@ -41,7 +41,8 @@ class VoyageCli : public ::testing::Test {
   Outcome run(const std::string& args) const {
     Outcome r;
     const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const int status = std::system(("'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'").c_str());
+    const int status =
+        std::system(("'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'").c_str());
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp(out);
     r.err = slurp(err);
@@ -70,7 +71,8 @@ TEST_F(VoyageCli, WritesTheSimColumnsAndUAndTheSameSeedGivesTheSameFile) {
 
 TEST_F(VoyageCli, ReplayReadsAVoyageCsv) {
   ASSERT_EQ(run("sim --vessel otter --scenario course --rate 10 --duration 120 --sensor mems "
-                "--output '" + path("v.csv") + "'")
+                "--output '" +
+                path("v.csv") + "'")
                 .code,
             0);
   const Outcome r = run("replay --config '" + kSource + "/config/vessels/otter.yaml' --input '" +

@@ -72,20 +72,20 @@ struct SeaState {
 SeaState sea_state(int code);
 
 struct EnvironmentConfig {
-  SeaState sea;                  ///< code 0: no wave motion
-  double wave_damping = 0.1;     ///< relative damping lambda of the wave shaping filter [-]
-  double wave_yaw_sigma = -1.0;  ///< std of the wave-induced yaw rate [rad/s]; < 0: from sea
+  SeaState sea;                   ///< code 0: no wave motion
+  double wave_damping = 0.1;      ///< relative damping lambda of the wave shaping filter [-]
+  double wave_yaw_sigma = -1.0;   ///< std of the wave-induced yaw rate [rad/s]; < 0: from sea
   double wave_sway_sigma = -1.0;  ///< std of the wave-induced sway velocity [m/s]; < 0: from sea
   /// Current over ground: the hull moves with the water (no force on the hull: its
   /// hydrodynamics act on the velocity through the water), the INS reads the current's cross
   /// component in the sway velocity; as the hull turns that component changes. In the
   /// engine's x' = A x + B delta on the measured v this is the sway force and yaw moment
   /// -A [v_c 0]^T (plus v_c').
-  double current = 0.0;           ///< mean current speed [m/s]
-  double current_sigma = 0.0;     ///< Gauss-Markov std of the current speed [m/s]
+  double current = 0.0;                           ///< mean current speed [m/s]
+  double current_sigma = 0.0;                     ///< Gauss-Markov std of the current speed [m/s]
   double current_direction = 1.5707963267948966;  ///< initial set, from the initial course [rad]
-  double current_direction_rw = 0.002;  ///< random walk of the set [rad/sqrt(s)]
-  double current_tau = 600.0;           ///< correlation time of the speed [s]
+  double current_direction_rw = 0.002;            ///< random walk of the set [rad/sqrt(s)]
+  double current_tau = 600.0;                     ///< correlation time of the speed [s]
   double wind = 0.0;        ///< mean wind yaw moment and sway force as an equivalent rudder [rad]
   double wind_sigma = 0.0;  ///< Gauss-Markov std of the gusts, same unit [rad]
   double wind_tau = 60.0;   ///< correlation time of the gusts [s]
@@ -115,9 +115,9 @@ struct ChannelNoise {
 };
 
 struct SensorConfig {
-  ChannelNoise v;      ///< accelerometer channel (sway velocity) [m/s]
-  ChannelNoise r;      ///< gyro [rad/s]
-  ChannelNoise delta;  ///< rudder angle sensor [rad]
+  ChannelNoise v;              ///< accelerometer channel (sway velocity) [m/s]
+  ChannelNoise r;              ///< gyro [rad/s]
+  ChannelNoise delta;          ///< rudder angle sensor [rad]
   double compass_sigma = 0.0;  ///< white noise of the heading reference [rad]
   double compass_tau = 100.0;  ///< the autopilot's heading: gyro integrated, pulled to the
                                ///< compass with this time constant [s] (0: compass alone)
@@ -138,10 +138,10 @@ bool apply_sensor_setting(const std::string& setting, SensorConfig* out, std::st
 // ------------------------------------------------------------------------------ voyage
 
 struct AutopilotConfig {
-  double bandwidth = -1.0;   ///< natural frequency of the heading loop [rad/s]; < 0: 1.2 U0/L
-  double damping = 0.9;      ///< relative damping [-]
-  double integral = 0.1;     ///< integral gain relative to bandwidth * Kp [-] (0: PD)
-  double dither = 0.0;       ///< rudder dither amplitude [rad] (0: none)
+  double bandwidth = -1.0;     ///< natural frequency of the heading loop [rad/s]; < 0: 1.2 U0/L
+  double damping = 0.9;        ///< relative damping [-]
+  double integral = 0.1;       ///< integral gain relative to bandwidth * Kp [-] (0: PD)
+  double dither = 0.0;         ///< rudder dither amplitude [rad] (0: none)
   double dither_period = 0.0;  ///< [s]; <= 0: 0.5 * leg period of the hull
 };
 
@@ -149,8 +149,8 @@ struct VoyageConfig {
   double rate_hz = 10.0;
   double duration = 600.0;  ///< [s]; the legs repeat until then
   std::uint64_t seed = 1;
-  int substeps = 10;        ///< RK4 steps per sample
-  std::vector<Leg> legs;    ///< empty: hold course
+  int substeps = 10;      ///< RK4 steps per sample
+  std::vector<Leg> legs;  ///< empty: hold course
   AutopilotConfig autopilot;
   EnvironmentConfig environment;
   SensorConfig sensors;
@@ -173,18 +173,18 @@ double channel_sigma(const VoyageConfig& cfg, Sensor sensor);
 
 /// One output sample: today's SimRow fields plus the voyage's.
 struct VoyageRow : SimRow {
-  double t_true = 0.0;      ///< sampling instant (t is the stamp, with jitter)
-  double u_true = 0.0;      ///< surge speed [m/s] (CSV column `u`)
+  double t_true = 0.0;                ///< sampling instant (t is the stamp, with jitter)
+  double u_true = 0.0;                ///< surge speed [m/s] (CSV column `u`)
   double v_lf = 0.0, r_lf = 0.0;      ///< the hull's low-frequency motion
   double v_wave = 0.0, r_wave = 0.0;  ///< first-order wave motion
-  double v_current = 0.0;  ///< cross component of the current (in v_true) [m/s]
-  double psi_meas = 0.0;    ///< the autopilot's heading [rad]
-  double delta_cmd = 0.0;   ///< rudder command (autopilot or manoeuvre, with dither) [rad]
-  double throttle = 1.0;    ///< [-]
-  double gyro_bias = 0.0;   ///< gyro bias (constant + random walk) [rad/s]
+  double v_current = 0.0;             ///< cross component of the current (in v_true) [m/s]
+  double psi_meas = 0.0;              ///< the autopilot's heading [rad]
+  double delta_cmd = 0.0;  ///< rudder command (autopilot or manoeuvre, with dither) [rad]
+  double throttle = 1.0;   ///< [-]
+  double gyro_bias = 0.0;  ///< gyro bias (constant + random walk) [rad/s]
   double dist_v = 0.0, dist_r = 0.0;  ///< wind accelerations [m/s^2, rad/s^2]
   Manoeuvre manoeuvre = Manoeuvre::kHold;
-  bool duplicate = false;   ///< this row repeats the previous one (a duplicated sample)
+  bool duplicate = false;  ///< this row repeats the previous one (a duplicated sample)
 };
 
 const char* to_string(Manoeuvre m);
