@@ -99,6 +99,11 @@ TEST_F(VoyageCli, BadVoyageOptionsAreNamed) {
       {"--scenario course --wave-period 8", "--wave-period needs a --sea-state"},
       {"--scenario course --fault-sigma gyro:bogus:1:2:3", "unknown kind 'bogus'"},
   };
+  const Outcome zoo = run("sim --vessel container --scenario paper" + out);
+  EXPECT_EQ(zoo.code, 64);
+  EXPECT_NE(zoo.err.find("the classic scenarios (paper, healthy, faults) run the shipped vessels"),
+            std::string::npos)
+      << zoo.err;
   for (const Case& c : cases) {
     const Outcome r = run("sim --vessel otter " + c.args + out);
     EXPECT_EQ(r.code, 64) << c.args << "\n" << r.err;
