@@ -107,7 +107,12 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   DataReader& rudder = dds_->create_reader(
       dds::TopicId::kRudder, cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
                                                   : dds::profiles::kRudderReaderBestEffort);
-  DataReader& ack = dds_->create_reader(dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
+  // Acks are read by a participant of their own: its traffic arrives on its own port, handled
+  // by its own receive thread, so a flood of acks cannot hold up (nor, through KEEP_LAST
+  // histories, lose) the INS and rudder samples behind it.
+  ack_dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
+  DataReader& ack =
+      ack_dds_->create_reader(dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
   listener_->ins_ = &ins;
   listener_->rudder_ = &rudder;
   listener_->ack_ = &ack;
@@ -239,7 +244,8 @@ void FdiService::stop() {
     if (r != nullptr) r->set_listener(nullptr);
   }
   pipeline_->stop();  // drains the queues; the publisher thread writes the last events
-  dds_.reset();       // delete_contained_entities(), then the participant
+  ack_dds_.reset();
+  dds_.reset();  // delete_contained_entities(), then the participant
 }
 
 }  // namespace usvfdi::service

@@ -94,6 +94,12 @@ std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
 
 int index_of(Sensor s) { return static_cast<int>(s); }
 
+/// Acks handled in one go when no sensor sample is waiting (then the input queue is looked
+/// at again).
+constexpr int kAckBatch = 16;
+/// Refused acks logged in full per ack_log_period before the rest are only summarised.
+constexpr int kAckLogBurst = 5;
+
 bool sensor_level(FaultKind k) {
   return k == FaultKind::kStale || k == FaultKind::kStuck || k == FaultKind::kInvalid;
 }
@@ -132,6 +138,7 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       on_status_(std::move(on_status)),
       on_log_(std::move(on_log)),
       input_(opt.input_capacity),
+      acks_(opt.ack_capacity),
       ident_q_(opt.ident_capacity),
       output_(opt.output_capacity),
       iso_(cfg.isolation, cfg.B),
@@ -173,6 +180,7 @@ void FdiPipeline::stop() {
   if (!started_ || stopped_) return;
   stopped_ = true;
   input_.shutdown();
+  acks_.shutdown();
   if (iso_thread_.joinable()) iso_thread_.join();
   ident_q_.shutdown();
   if (ident_thread_.joinable()) ident_thread_.join();
@@ -360,15 +368,19 @@ void FdiPipeline::recheck_restored(const Sample& s) {
 
 void FdiPipeline::handle_ack(const AckInput& a) {
   FaultEvent ev;
+  const std::string what =
+      std::string("ack of ") +
+      (static_cast<int>(a.sensor) > 2 ? "sensor " + std::to_string(static_cast<int>(a.sensor))
+                                      : std::string(to_string(a.sensor))) +
+      " #" + std::to_string(a.sequence) + " by " + a.who;
   if (!opt_.authorised_operators.empty() &&
       std::find(opt_.authorised_operators.begin(), opt_.authorised_operators.end(), a.who) ==
           opt_.authorised_operators.end()) {
-    log(2, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
-               " refused: operator '" + a.who + "' is not authorised");
+    refuse_ack(a, "not authorised", what + " refused: operator '" + a.who + "' is not authorised");
     return;
   }
   if (static_cast<int>(a.sensor) > 2) {
-    log(2, "ack refused: unknown sensor " + std::to_string(static_cast<int>(a.sensor)));
+    refuse_ack(a, "unknown sensor", what + " refused: unknown sensor");
     return;
   }
   FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
@@ -377,14 +389,68 @@ void FdiPipeline::handle_ack(const AckInput& a) {
   const double t = std::isfinite(last_t_) ? last_t_ : latch.current().t;
   const AckResult r = latch.acknowledge(a.sequence, t, a.who, &ev);
   if (r == AckResult::kAccepted) {
+    ++acks_accepted_;
     log(1, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
                " by " + a.who + " accepted");
     emit(ev);
   } else {
-    log(2, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
-               " by " + a.who + " refused: " + to_string(r) + " (current #" +
-               std::to_string(current) + ", state " + to_string(latch.state()) + ")");
+    refuse_ack(a, to_string(r),
+               what + " refused: " + to_string(r) + " (current #" + std::to_string(current) +
+                   ", state " + to_string(latch.state()) + ")");
   }
+}
+
+void FdiPipeline::refuse_ack(const AckInput&, const std::string& reason,
+                             const std::string& detail) {
+  ++acks_refused_;
+  AckRefusals& r = refusals_;
+  ++r.total;
+  if (r.logged_in_period < kAckLogBurst) {
+    // The first few refusals of a period are logged at once, in full: an operator who
+    // mistyped a sequence sees why.
+    ++r.logged_in_period;
+    log(2, detail);
+    return;
+  }
+  ++r.unlogged;
+  auto it = std::find_if(r.by_reason.begin(), r.by_reason.end(),
+                         [&](const auto& x) { return x.first == reason; });
+  if (it == r.by_reason.end()) {
+    r.by_reason.emplace_back(reason, 1);
+  } else {
+    ++it->second;
+  }
+  r.example = detail;
+}
+
+void FdiPipeline::log_ack_summary(bool force) {
+  AckRefusals& r = refusals_;
+  const auto now = std::chrono::steady_clock::now();
+  const double age = std::chrono::duration<double>(now - r.period_start).count();
+  if (!force && age < opt_.ack_log_period) return;
+  const std::uint64_t dropped = acks_.dropped();
+  if (r.unlogged > 0 || dropped > r.dropped_logged) {
+    std::string reasons;
+    for (const auto& [why, n] : r.by_reason) {
+      reasons += (reasons.empty() ? "" : ", ") + std::to_string(n) + " " + why;
+    }
+    std::string msg = "acks: " + std::to_string(r.unlogged) + " more ack(s) refused in the last " +
+                      fmt("%.1f s", age) + " (" + std::to_string(r.total) + " since start" +
+                      (reasons.empty() ? std::string() : "; " + reasons) + ")";
+    if (dropped > r.dropped_logged) {
+      msg += "; " + std::to_string(dropped - r.dropped_logged) +
+             " dropped unread: the ack queue (" + std::to_string(acks_.capacity()) +
+             ") was full (" + std::to_string(dropped) + " since start)";
+    }
+    if (!r.example.empty()) msg += "; e.g. " + r.example;
+    log(2, msg);
+  }
+  r.dropped_logged = dropped;
+  r.unlogged = 0;
+  r.by_reason.clear();
+  r.example.clear();
+  r.logged_in_period = 0;
+  r.period_start = now;
 }
 
 PipelineStatus FdiPipeline::make_status() {
@@ -504,6 +570,9 @@ PipelineStatus FdiPipeline::status() const {
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
   st.dropped_output = output_.dropped() + dropped_at_stop_.load();
+  st.acks_accepted = acks_accepted_.load();
+  st.acks_refused = acks_refused_.load();
+  st.acks_dropped = acks_.dropped();
   return st;
 }
 
@@ -526,16 +595,28 @@ PipelineLiveness FdiPipeline::liveness() const {
 
 void FdiPipeline::isolation_loop() {
   using Clock = std::chrono::steady_clock;
-  for (const FaultEvent& ev : restored_) emit(ev);
+  for (const FaultEvent& ev : restored_) emit(ev, true);
   auto last_status = Clock::now();
   auto last_ins = Clock::now();
+  refusals_.period_start = last_status;
   std::vector<Sample> batch;
   const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
   for (;;) {
     beat_iso_.store(now_ns(), std::memory_order_relaxed);
     Input in;
-    const auto r = input_.pop_for(&in, std::chrono::milliseconds(50));
+    // Acks waiting: look for a sensor sample without waiting, and take the acks only when
+    // there is none (acks never go ahead of, nor delay, the sensor samples).
+    const bool acks_waiting = acks_.size() > 0;
+    const auto r = input_.pop_for(&in, std::chrono::milliseconds(acks_waiting ? 0 : 50));
     if (r == BoundedQueue<Input>::PopResult::kShutdown) break;
+    if (r == BoundedQueue<Input>::PopResult::kTimeout && acks_waiting) {
+      AckInput a;
+      for (int k = 0; k < kAckBatch && acks_.pop_for(&a, std::chrono::milliseconds(0)) ==
+                                           BoundedQueue<AckInput>::PopResult::kValue;
+           ++k) {
+        handle_ack(a);
+      }
+    }
     const auto now = Clock::now();
     if (r == BoundedQueue<Input>::PopResult::kValue) {
       if (const auto* ins = std::get_if<InsInput>(&in)) {
@@ -543,10 +624,8 @@ void FdiPipeline::isolation_loop() {
         last_ins = now;
         had_ins_ = true;
         if (ins_silent_.exchange(false)) log(1, "INS samples arrive again");
-      } else if (const auto* rud = std::get_if<RudderInput>(&in)) {
-        accept_rudder(*rud);
       } else {
-        handle_ack(std::get<AckInput>(in));
+        accept_rudder(std::get<RudderInput>(in));
       }
       batch.clear();
       assembler_.drain(&batch);
@@ -567,6 +646,7 @@ void FdiPipeline::isolation_loop() {
       last_status = now;
       const PipelineStatus st = make_status();
       log_input_changes(st);
+      log_ack_summary(false);
       {
         std::lock_guard<std::mutex> lock(snap_m_);
         last_status_ = st;
@@ -577,6 +657,7 @@ void FdiPipeline::isolation_loop() {
   batch.clear();
   assembler_.drain(&batch, true);
   for (const Sample& s : batch) process(s);
+  log_ack_summary(true);
   const PipelineStatus st = make_status();
   std::lock_guard<std::mutex> lock(snap_m_);
   last_status_ = st;

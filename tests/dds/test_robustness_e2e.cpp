@@ -514,6 +514,86 @@ TEST(BadInput, ABurstLargerThanTheInputQueueDropsTheOldestAndSaysSo) {
   kill_and_reap(svc, SIGTERM, 0);
 }
 
+// ------------------------------------------------------------------ acknowledgement flood
+
+/// The residual fault of `sensor` on (t0, t1) as the monitor saw it (events before the end
+/// of the data, t < 100 s): raised within 3 s of t0 and isolated to it, cleared after t1.
+void expect_episode(const std::vector<MonitorEvent>& all, const std::string& sensor, double t0,
+                    double t1) {
+  SCOPED_TRACE(sensor);
+  std::vector<MonitorEvent> in;
+  for (const auto& e : all) {
+    if (e.sensor == sensor && e.stamp < 100.0) in.push_back(e);
+  }
+  ASSERT_GE(in.size(), 2u) << "expected raised and cleared";
+  EXPECT_EQ(in.front().state, "raised");
+  EXPECT_GE(in.front().stamp, t0) << "raised before the fault's onset: a false raise";
+  EXPECT_LE(in.front().stamp, t0 + 3.0);
+  EXPECT_GE(sensor == "gyro" ? in.front().c_g : in.front().c_a, 0.8) << "not isolated";
+  EXPECT_EQ(in.back().state, "cleared");
+  EXPECT_GE(in.back().stamp, t1);
+  EXPECT_LE(in.back().stamp, t1 + 5.0);
+  for (std::size_t i = 1; i + 1 < in.size(); ++i) {
+    EXPECT_EQ(in[i].state, "raised") << "only kind refinements between";
+  }
+}
+
+TEST(AckFlood, RefusedAcksAreCountedInBoundedLogAndDetectionIsUnchanged) {
+  Fleet f;
+  const unsigned m = 257300010;
+  const std::string ms = std::to_string(m);
+  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60"});
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  ChildProcess& svc = f.start_service("svc", cfg, 1);
+  // GIVEN a participant that floods the sidecar with acks it must refuse
+  ChildProcess& flood = f.start_probe("flood", "flood-acks", {"--mmsi", ms, "--timeout", "120"});
+  const auto first = flood.read_line(seconds(20));
+  ASSERT_TRUE(first && *first == "flooding") << f.log("flood");
+  // WHEN the vessel sails the paper's scenario (5x real time) through the flood
+  const auto t0 = Clock::now();
+  ChildProcess& sim = f.start("sim", sim_args({"--mmsi", ms, "--speed", "5"}));
+  const auto sim_code = sim.wait_exit(seconds(90));
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_TRUE(sim_code.has_value() && *sim_code == 0) << f.log("sim");
+  const auto until = Clock::now() + seconds(10);
+  while (Clock::now() < until) {
+    const Key k = logged_latest(f.log("svc"), m);
+    if (k.count("accelerometer") && k.at("accelerometer").second == "cleared") break;
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  flood.signal(SIGTERM);
+  const std::string flooded = flood.read_all(seconds(10));
+  ASSERT_TRUE(flood.wait_exit(seconds(5)).has_value());
+  unsigned long long acks = 0;
+  ASSERT_EQ(std::sscanf(flooded.c_str(), "flooded acks=%llu", &acks), 1) << flooded;
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  read_monitor_until(
+      control, &ev, &st, seconds(3), [](const auto&) { return false; }, &err);
+  const std::string log = f.log("svc");
+  std::printf("ack flood: %llu acks in %.1f s (%.0f/s), sidecar log %zu bytes\n", acks, wall,
+              static_cast<double>(acks) / wall, log.size());
+  // THEN it was a flood (thousands of acks a second)
+  EXPECT_GE(static_cast<double>(acks) / wall, 1000.0) << "not a flood";
+  // AND each fault was raised at its onset on its own sensor and cleared; nothing else
+  expect_episode(ev, "gyro", 20.0, 40.0);
+  expect_episode(ev, "accelerometer", 60.0, 80.0);
+  for (const auto& e : ev) EXPECT_NE(e.sensor, "unknown") << dump(ev);
+  EXPECT_FALSE(ev.empty()) << dump(ev);
+  // AND no sensor sample was lost to the flood, neither in DDS nor in the sidecar's queue
+  ASSERT_FALSE(st.empty());
+  EXPECT_EQ(st.back().dropped_inputs, 0u);
+  EXPECT_GE(st.back().samples, 5000u);
+  // AND the refusals are summarised: the log stays small (about a line per second of
+  // flood), where one line per refused ack would be some 100 bytes x acks
+  EXPECT_NE(log.find("more ack(s) refused in the last"), std::string::npos) << log.substr(0, 4000);
+  EXPECT_NE(log.find("unknown sequence"), std::string::npos);
+  EXPECT_LT(log.size(), 100000u + 200u * static_cast<std::size_t>(wall)) << log.substr(0, 4000);
+  ASSERT_TRUE(svc.running());
+  kill_and_reap(svc, SIGTERM, 0);
+}
+
 // ------------------------------------------------------------------ configuration mistakes
 
 TEST(BadConfig, MistakesNameTheFileKeyAndValue) {

@@ -93,6 +93,8 @@ class FdiService {
   std::unique_ptr<FdiPipeline> pipeline_;
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<usv_fdi::dds::DdsContext> dds_;
+  /// The participant of the ack reader alone (its own port and receive thread).
+  std::unique_ptr<usv_fdi::dds::DdsContext> ack_dds_;
   eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
   bool stopped_ = false;

@@ -3,6 +3,10 @@
 //   latch, acks) -> identification queue -> identification thread (DREM, publishes estimate
 //   snapshots back to the isolation thread) ; isolation thread -> output queue -> publisher
 //   thread (hands events and status to the sink, so a slow writer never blocks isolation).
+// Operator acknowledgements have a bounded queue of their own: the isolation thread takes
+// them only when no sensor sample is waiting, so a flood of acks can neither delay nor
+// re-order sensor processing; refused acks are counted and logged with a rate limit (the
+// first few of an ack_log_period in full, then one summary line with counts and an example).
 // Overflow policy: every queue drops its oldest element when full and counts the drop; the
 // latest state of every fault instance still reaches the sink after an output overflow.
 // Input problems (bad stamps, invalid values, gaps, re-ordering, overflow, silent streams) are
@@ -74,7 +78,8 @@ class SampleAssembler {
 };
 
 struct PipelineOptions {
-  std::size_t input_capacity = 4096;   ///< listener -> isolation thread
+  std::size_t input_capacity = 4096;   ///< listener -> isolation thread (INS, rudder)
+  std::size_t ack_capacity = 64;       ///< listener -> isolation thread (acks; oldest dropped)
   std::size_t ident_capacity = 16384;  ///< isolation -> identification thread
   std::size_t output_capacity = 4096;  ///< isolation -> publisher thread
   double rudder_wait = 0.1;            ///< [s, source time]
@@ -189,14 +194,15 @@ class FdiPipeline {
     last_rudder_ns_.store(now_ns(), std::memory_order_relaxed);
     return input_.push(s);
   }
-  bool push_ack(const AckInput& a) { return input_.push(a); }
+  /// Acks have their own queue: they never take a sensor sample's place nor go before it.
+  bool push_ack(const AckInput& a) { return acks_.push(a); }
 
   PipelineStatus status() const;
   /// For a health check: how recently each thread went round its loop.
   PipelineLiveness liveness() const;
 
  private:
-  using Input = std::variant<InsInput, RudderInput, AckInput>;
+  using Input = std::variant<InsInput, RudderInput>;
   using Output = std::variant<FaultEvent, PipelineStatus>;
   struct IdentItem {
     Sample s;
@@ -244,6 +250,8 @@ class FdiPipeline {
   void publish(const FaultEvent& ev);
   void publish_latest();
   void handle_ack(const AckInput& a);
+  void refuse_ack(const AckInput& a, const std::string& reason, const std::string& detail);
+  void log_ack_summary(bool force);
   void log(int level, const std::string& msg) const;
   void log_input_changes(const PipelineStatus& st);
   PipelineStatus make_status();
@@ -276,6 +284,19 @@ class FdiPipeline {
   bool had_ins_ = false;           ///< an INS sample has arrived since start
   bool never_ins_logged_ = false;  ///< "no INS sample since start" was logged
   std::chrono::steady_clock::time_point started_at_{};
+  /// Refused acks (isolation thread): counts since start, and what the current log period
+  /// has not logged yet.
+  struct AckRefusals {
+    std::uint64_t total = 0;
+    std::uint64_t unlogged = 0;  ///< refused in this period after the first (not logged yet)
+    std::uint64_t dropped_logged = 0;
+    std::vector<std::pair<std::string, std::uint64_t>> by_reason;  ///< this period
+    std::string example;       ///< the latest unlogged refusal, in full
+    int logged_in_period = 0;  ///< refusals logged in full in this period
+    std::chrono::steady_clock::time_point period_start{};
+  };
+  AckRefusals refusals_;
+  std::atomic<std::uint64_t> acks_accepted_{0}, acks_refused_{0};
 
   // Identification thread state.
   Identifier ident_;
