@@ -105,16 +105,18 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   }
   if (s.identification_paused & kPauseFault) msg += "identification frozen (fault); ";
   if (s.rejected > 0) msg += std::to_string(s.rejected) + " samples rejected; ";
+  if (s.lost_ins + s.lost_rudder > 0)
+    msg += std::to_string(s.lost_ins + s.lost_rudder) + " samples lost; ";
   d.message(msg.substr(0, 127).c_str());
   return d;
 }
 
 InsInput from_dds(const fdi::InsSample& s) {
-  return InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid()};
+  return InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid(), s.seq()};
 }
 
 RudderInput from_dds(const fdi::RudderSample& s) {
-  return RudderInput{s.stamp(), s.delta(), s.valid()};
+  return RudderInput{s.stamp(), s.delta(), s.valid(), s.seq()};
 }
 
 AckInput from_dds(const fdi::FaultAck& a) {

@@ -130,6 +130,30 @@ std::string pause_reason_names(std::uint32_t reasons) {
 
 // ---------------------------------------------------------------- FdiPipeline
 
+void FdiPipeline::SeqGaps::see(std::uint64_t seq) {
+  if (seq == 0) return;
+  std::uint64_t high = highest_.load(std::memory_order_relaxed);
+  for (;;) {
+    if (high != 0 && seq <= high) {
+      if (high - seq >= kRestartWindow) {
+        // The source started counting again (a restart): follow it, nothing was lost.
+        if (!highest_.compare_exchange_weak(high, seq, std::memory_order_relaxed)) continue;
+        restarts_.fetch_add(1, std::memory_order_relaxed);
+        return;
+      }
+      // A late sample of a gap counted already (DDS does not deliver duplicates).
+      std::uint64_t lost = lost_.load(std::memory_order_relaxed);
+      while (lost > 0 && !lost_.compare_exchange_weak(lost, lost - 1, std::memory_order_relaxed)) {
+      }
+      return;
+    }
+    if (highest_.compare_exchange_weak(high, seq, std::memory_order_relaxed)) {
+      if (high != 0) lost_.fetch_add(seq - high - 1, std::memory_order_relaxed);
+      return;
+    }
+  }
+}
+
 FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, EventSink on_event,
                          StatusSink on_status, LogSink on_log)
     : cfg_((cfg.validate(), cfg)),
@@ -473,6 +497,8 @@ PipelineStatus FdiPipeline::make_status() {
   st.invalid_values = in.invalid_values + problems_.invalid;
   st.gaps = in.gaps;
   st.reordered = problems_.reordered;
+  st.lost_ins = ins_seq_.lost();
+  st.lost_rudder = rudder_seq_.lost();
   std::uint32_t f = 0;
   if (st.ins_silent) f |= kInputInsSilent;
   if (!in.delta_ok) f |= kInputRudderMissing;
@@ -483,6 +509,7 @@ PipelineStatus FdiPipeline::make_status() {
   if (st.gaps > logged_.gaps) f |= kInputGaps;
   if (st.reordered > logged_.reordered) f |= kInputReordered;
   if (st.dropped_inputs > logged_.dropped_inputs) f |= kInputQueueDrops;
+  if (st.lost_ins + st.lost_rudder > logged_.lost) f |= kInputSamplesLost;
   st.input_flags = f;
   // Why identification and isolation do not run.
   std::uint32_t id = 0, iso = 0;
@@ -547,6 +574,19 @@ void FdiPipeline::log_input_changes(const PipelineStatus& st) {
                " sample(s) dropped, oldest first (" + std::to_string(st.dropped_inputs) +
                " since start): samples arrive faster than the isolation thread processes them");
   }
+  const std::uint64_t lost = st.lost_ins + st.lost_rudder;
+  if (lost > logged_.lost) {
+    log(2, "inputs: " + more(lost, logged_.lost) +
+               " sample(s) lost before reaching the sidecar (gaps in the sources' seq; " +
+               std::to_string(st.lost_ins) + " INS and " + std::to_string(st.lost_rudder) +
+               " rudder since start)");
+  }
+  const std::uint64_t restarts = ins_seq_.restarts() + rudder_seq_.restarts();
+  if (restarts > logged_.seq_restarts) {
+    log(1,
+        "inputs: an INS or rudder source started numbering its samples again (seq far "
+        "below the highest seen): taken as a restart of the source, not as a loss");
+  }
   if (st.ins_silent && !had_ins_ && !never_ins_logged_) {
     never_ins_logged_ = true;
     log(2,
@@ -558,6 +598,8 @@ void FdiPipeline::log_input_changes(const PipelineStatus& st) {
   logged_.gaps = st.gaps;
   logged_.reordered = st.reordered;
   logged_.dropped_inputs = st.dropped_inputs;
+  logged_.lost = lost;
+  logged_.seq_restarts = restarts;
 }
 
 PipelineStatus FdiPipeline::status() const {

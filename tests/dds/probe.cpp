@@ -26,6 +26,8 @@
 //                                           PACE_MS wall-clock ms apart (0: as fast as possible)
 //       insonly T0 T1 DT PACE_MS            the same, INS only (a silent rudder)
 //       sleep MS
+//       skip N                              N INS and N rudder sample numbers (seq) left out,
+//                                           as if lost on the way
 //
 //   usv_fdi_dds_probe slow-reader --profiles FILE [DDS options] [--delay-ms D]
 //     The slowest subscriber there is: FaultEvent and FdiStatus readers RELIABLE,
@@ -372,6 +374,9 @@ int publish_inputs(const Options& o) {
                   0.002 * std::cos(0.3 * t) + 0.0002 * std::cos(11 * t), true, true);
         if (pace > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(pace));
       }
+    } else if (w[0] == "skip") {
+      n_ins += static_cast<std::uint64_t>(arg(1));
+      n_rudder += static_cast<std::uint64_t>(arg(1));
     } else if (w[0] == "sleep") {
       std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(arg(1)));
     } else {

@@ -585,12 +585,52 @@ TEST(AckFlood, RefusedAcksAreCountedInBoundedLogAndDetectionIsUnchanged) {
   ASSERT_FALSE(st.empty());
   EXPECT_EQ(st.back().dropped_inputs, 0u);
   EXPECT_GE(st.back().samples, 5000u);
+  for (const auto& s : st) EXPECT_FALSE(s.has_flag("samples_lost"));
   // AND the refusals are summarised: the log stays small (about a line per second of
   // flood), where one line per refused ack would be some 100 bytes x acks
   EXPECT_NE(log.find("more ack(s) refused in the last"), std::string::npos) << log.substr(0, 4000);
   EXPECT_NE(log.find("unknown sequence"), std::string::npos);
   EXPECT_LT(log.size(), 100000u + 200u * static_cast<std::size_t>(wall)) << log.substr(0, 4000);
   ASSERT_TRUE(svc.running());
+  kill_and_reap(svc, SIGTERM, 0);
+}
+
+// ------------------------------------------------------------------ burst loss
+
+TEST(BadInput, SamplesLostOnTheWayAreCountedFromTheSeqGapsAndFlagged) {
+  Fleet f;
+  const unsigned m = 257300013;
+  const std::string ms = std::to_string(m);
+  const std::string cfg =
+      f.write_service_config("svc", m, {"status_rate: 10", "input_timeout: 60"});
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  ChildProcess& svc = f.start_service("svc", cfg, 1);
+  // GIVEN a source whose sample numbers jump twice: 7 and then 5 INS and rudder samples never
+  // reach the sidecar
+  const std::string script = f.dir() + "lost.script";
+  std::ofstream(script) << "both 0 2 0.02 0\nskip 7\nboth 2 4 0.02 0\nskip 5\nboth 4 5 0.02 0\n";
+  ChildProcess& probe = f.start_probe("probe", "publish-inputs",
+                                      {"--mmsi", ms, "--script", script, "--timeout", "20"});
+  const auto pcode = probe.wait_exit(seconds(40));
+  ASSERT_TRUE(pcode.has_value() && *pcode == 0) << f.log("probe");
+  // THEN a status period flags the loss, and the log counts it per stream
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  EXPECT_TRUE(read_monitor_until(
+      control, &ev, &st, seconds(15),
+      [&](const auto&) {
+        return std::any_of(st.begin(), st.end(),
+                           [](const MonitorStatus& s) { return s.has_flag("samples_lost"); });
+      },
+      &err))
+      << err << f.log("svc");
+  ASSERT_TRUE(f.wait_for_log("svc", "12 INS and 12 rudder since start", seconds(10)))
+      << f.log("svc");
+  EXPECT_NE(f.log("svc").find("sample(s) lost before reaching the sidecar"), std::string::npos);
+  // AND the samples that arrived were all processed (nothing dropped by the sidecar itself)
+  ASSERT_FALSE(st.empty());
+  EXPECT_EQ(st.back().dropped_inputs, 0u);
   kill_and_reap(svc, SIGTERM, 0);
 }
 

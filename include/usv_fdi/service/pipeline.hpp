@@ -38,12 +38,14 @@ struct InsInput {
   double r = kNaN;      ///< [rad/s]
   bool v_valid = true;
   bool r_valid = true;
+  std::uint64_t seq = 0;  ///< the source's sample number (InsSample.seq); 0: not numbered
 };
 
 struct RudderInput {
   double stamp = kNaN;  ///< source time [s]
   double delta = kNaN;  ///< [rad]
   bool valid = true;
+  std::uint64_t seq = 0;  ///< the source's sample number (RudderSample.seq); 0: not numbered
 };
 
 struct AckInput {
@@ -145,11 +147,14 @@ struct PipelineStatus {
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
   // Input problems, counted since start (see InputFlag for the per-period flags).
-  std::uint32_t input_flags = 0;            ///< InputFlag bits
-  std::uint64_t rejected_timestamps = 0;    ///< repeated/backward (engine) + non-finite stamps
-  std::uint64_t invalid_values = 0;         ///< NaN flagged valid, Inf, absurd magnitudes
-  std::uint64_t gaps = 0;                   ///< gaps longer than stale_timeout
-  std::uint64_t reordered = 0;              ///< INS samples older than one already received
+  std::uint32_t input_flags = 0;          ///< InputFlag bits
+  std::uint64_t rejected_timestamps = 0;  ///< repeated/backward (engine) + non-finite stamps
+  std::uint64_t invalid_values = 0;       ///< NaN flagged valid, Inf, absurd magnitudes
+  std::uint64_t gaps = 0;                 ///< gaps longer than stale_timeout
+  std::uint64_t reordered = 0;            ///< INS samples older than one already received
+  /// Samples lost before they reached the sidecar (in DDS or the source): gaps in the seq of
+  /// InsSample / RudderSample, since start (a late sample of a gap is taken off again).
+  std::uint64_t lost_ins = 0, lost_rudder = 0;
   std::uint32_t identification_paused = 0;  ///< PauseReason bits (0: identifying)
   std::uint32_t isolation_paused = 0;       ///< PauseReason bits (0: detecting)
 };
@@ -186,12 +191,16 @@ class FdiPipeline {
   void stop();
 
   // Called from middleware listeners: copy into the input queue, never block.
+  // The seq of each stream is checked here, before the input queue: gaps are losses before
+  // the sidecar (the queue counts its own drops).
   bool push_ins(const InsInput& s) {
     last_ins_ns_.store(now_ns(), std::memory_order_relaxed);
+    ins_seq_.see(s.seq);
     return input_.push(s);
   }
   bool push_rudder(const RudderInput& s) {
     last_rudder_ns_.store(now_ns(), std::memory_order_relaxed);
+    rudder_seq_.see(s.seq);
     return input_.push(s);
   }
   /// Acks have their own queue: they never take a sensor sample's place nor go before it.
@@ -231,7 +240,7 @@ class FdiPipeline {
   /// What the previous status period's log summary had seen.
   struct ProblemCounts {
     std::uint64_t rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
-                  dropped_inputs = 0;
+                  dropped_inputs = 0, lost = 0, seq_restarts = 0;
   };
 
   static std::int64_t now_ns() {
@@ -263,6 +272,8 @@ class FdiPipeline {
   LogSink on_log_;
 
   BoundedQueue<Input> input_;
+  BoundedQueue<AckInput> acks_;
+  SeqGaps ins_seq_, rudder_seq_;
   BoundedQueue<IdentItem> ident_q_;
   BoundedQueue<Output> output_;
 
