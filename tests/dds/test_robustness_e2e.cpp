@@ -10,8 +10,10 @@
 //   - bad input over DDS: each kind logged, counted and flagged in FdiStatus, no crash;
 //   - configuration mistakes: exit 2 (or 64) naming file, key and value.
 // Every wait is bounded by a deadline on a condition; no sleep is an assertion.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -593,6 +595,68 @@ TEST(AckFlood, RefusedAcksAreCountedInBoundedLogAndDetectionIsUnchanged) {
   EXPECT_LT(log.size(), 100000u + 200u * static_cast<std::size_t>(wall)) << log.substr(0, 4000);
   ASSERT_TRUE(svc.running());
   kill_and_reap(svc, SIGTERM, 0);
+}
+
+// ------------------------------------------------------------------ unread stderr
+
+TEST(UnreadStderr, TheSidecarStillPublishesAndStopsOnSigterm) {
+  Fleet f;
+  const unsigned m = 257300012;
+  const std::string ms = std::to_string(m);
+  const std::string cfg =
+      f.write_service_config("svc", m, {"status_rate: 10", "input_timeout: 60"});
+  // GIVEN a sidecar whose stderr is a pipe (of one page) that nobody reads
+  int fds[2];
+  ASSERT_EQ(::pipe2(fds, O_CLOEXEC), 0);
+  (void)::fcntl(fds[1], F_SETPIPE_SZ, 4096);
+  // full from the start: the sidecar's first line to stderr already blocks (its own open of
+  // the pipe blocks; ours here does not)
+  ASSERT_EQ(::fcntl(fds[1], F_SETFL, O_NONBLOCK), 0);
+  const std::string page(4096, 'x');
+  std::size_t filled = 0;
+  for (ssize_t n; (n = ::write(fds[1], page.data(), page.size())) > 0;) {
+    filled += static_cast<std::size_t>(n);
+  }
+  ASSERT_GT(filled, 0u);
+  std::vector<std::string> argv = {USV_FDI_EXE, "run", "--config", cfg};
+  for (const auto& x : f.dds_args()) argv.push_back(x);
+  auto svc = std::make_unique<ChildProcess>(argv, "/proc/self/fd/" + std::to_string(fds[1]));
+  ::close(fds[1]);
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  // AND much to log: refused acks (some lines in full) and a voyage with its events
+  ChildProcess& flood = f.start_probe("flood", "flood-acks", {"--mmsi", ms, "--timeout", "60"});
+  const auto first = flood.read_line(seconds(20));
+  ASSERT_TRUE(first && *first == "flooding") << f.log("flood");
+  ChildProcess& sim = f.start("sim", sim_args({"--mmsi", ms, "--speed", "10", "--duration", "45"}));
+  // WHEN the pipe has long been full THEN the sidecar still processes and publishes: the
+  // status shows the voyage's samples, the gyro fault is raised and cleared
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  const bool went_on = read_monitor_until(
+      control, &ev, &st, seconds(60),
+      [&](const std::vector<MonitorEvent>& e) {
+        bool cleared = false;
+        for (const auto& x : e)
+          cleared |= x.mmsi == m && x.sensor == "gyro" && x.state == "cleared";
+        return cleared && !st.empty() && st.back().samples >= 2000;
+      },
+      &err);
+  EXPECT_TRUE(went_on) << err << dump(ev)
+                       << (st.empty() ? std::string("no status")
+                                      : "samples " + std::to_string(st.back().samples));
+  const auto sim_code = sim.wait_exit(seconds(30));
+  EXPECT_TRUE(sim_code.has_value() && *sim_code == 0) << f.log("sim");
+  flood.signal(SIGTERM);
+  // AND it exits 0 on SIGTERM although its last lines cannot be written
+  const auto t0 = Clock::now();
+  svc->signal(SIGTERM);
+  const auto code = svc->wait_exit(seconds(15));
+  const double took = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_TRUE(code.has_value()) << "SIGTERM ignored: still running 15 s later";
+  EXPECT_EQ(*code, 0);
+  std::printf("with stderr unread: stopped %.3f s after SIGTERM\n", took);
+  ::close(fds[0]);
 }
 
 // ------------------------------------------------------------------ burst loss
