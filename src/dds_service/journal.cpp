@@ -216,12 +216,34 @@ bool StateJournal::parse(const std::string& text_in, std::uint32_t mmsi, Content
   return false;
 }
 
+std::string StateJournal::file_type(unsigned mode) {
+  if (S_ISREG(mode)) return "a regular file";
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
+}
+
 StateJournal::LoadResult StateJournal::load(const std::string& path, std::uint32_t mmsi,
                                             Contents* out, std::string* error) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO (or a device) must not wait for a writer; only a regular file
+  // is read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
   if (fd < 0) {
     if (errno == ENOENT) return LoadResult::kMissing;
     *error = path + ": cannot open: " + std::strerror(errno);
+    return LoadResult::kError;
+  }
+  struct stat sb {};
+  if (::fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+    *error = path + ": " +
+             (S_ISREG(sb.st_mode)
+                  ? std::string("cannot stat: ") + std::strerror(errno)
+                  : "is " + file_type(sb.st_mode) + ", not a state file (a regular file)");
+    ::close(fd);
     return LoadResult::kError;
   }
   std::string text;
@@ -260,7 +282,10 @@ bool StateJournal::write_atomic(const std::string& path, const std::string& text
     ::unlink(tmp.c_str());
     return false;
   };
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
+  // A fresh file, never whatever is at <path>.tmp (a FIFO there would block the open).
+  if (::unlink(tmp.c_str()) != 0 && errno != ENOENT) return fail("cannot remove " + tmp, -1);
+  const int fd =
+      ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0640);
   if (fd < 0) return fail("cannot create " + tmp, -1);
   std::size_t done = 0;
   while (done < text.size()) {

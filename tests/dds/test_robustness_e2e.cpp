@@ -13,10 +13,13 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -221,6 +224,29 @@ TEST(StateFile, CorruptFileOrUnusableDirectoryIsReportedAndTheSidecarStillStarts
                                "NOT survive a restart"),
             std::string::npos)
       << f.log("none");
+}
+
+TEST(StateFile, AFifoAtTheStatePathDoesNotHangStartUp) {
+  Fleet f;
+  const unsigned m = 257300011;
+  const std::string cfg = f.write_service_config("svc", m);
+  const std::string state_file =
+      f.state_dir("svc") + "/usv-fdi-" + std::to_string(m) + ".state.json";
+  // GIVEN a FIFO (nobody writing to it) where the state file should be
+  fs::create_directories(f.state_dir("svc"));
+  ASSERT_EQ(::mkfifo(state_file.c_str(), 0600), 0) << std::strerror(errno);
+  // WHEN the sidecar starts THEN it does not wait for a writer: it says what is there, sets
+  // it aside and runs with no latched faults
+  ChildProcess& svc = f.start_service("svc", cfg);
+  const std::string log = f.log("svc");
+  EXPECT_NE(log.find("state: cannot restore latched faults: " + state_file +
+                     ": is a FIFO (named pipe), not a state file (a regular file)"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("starting with no latched faults"), std::string::npos) << log;
+  EXPECT_TRUE(fs::is_regular_file(state_file)) << "a fresh state file is written";
+  ASSERT_TRUE(svc.running());
+  kill_and_reap(svc, SIGTERM, 0);
 }
 
 // ------------------------------------------------------------------ health check

@@ -62,13 +62,17 @@ class StateJournal {
 
   enum class LoadResult : std::uint8_t { kLoaded, kMissing, kError };
   /// Reads the file at `path`. kMissing: no such file (a first start). kError: *error names
-  /// the file and what was wrong (unreadable, not JSON, wrong version or MMSI, checksum ...).
+  /// the file and what was wrong (unreadable, not a regular file, not JSON, wrong version or
+  /// MMSI, checksum ...). Never blocks: a FIFO or device at `path` is refused unopened-for-I/O.
   static LoadResult load(const std::string& path, std::uint32_t mmsi, Contents* out,
                          std::string* error);
 
   /// Replaces `path` by `text` atomically and durably: <path>.tmp, fsync, rename, fsync of
   /// the directory. Returns false with *error (path and errno text); `path` is then unchanged.
   static bool write_atomic(const std::string& path, const std::string& text, std::string* error);
+
+  /// "a FIFO (named pipe)", "a directory", ... for a stat mode.
+  static std::string file_type(unsigned mode);
 
   /// Renames a bad state file to <path>.corrupt-<UTC time> so that it is kept for inspection
   /// and not read again. Returns the new name, or "" (with *error) if that failed.
