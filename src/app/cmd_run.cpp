@@ -20,6 +20,10 @@
 namespace usvfdi::app {
 namespace {
 
+/// Exit code when another sidecar holds the state directory's lock for this MMSI
+/// (EX_TEMPFAIL: it may start once the other one has stopped). Documented in docs/dds.md.
+constexpr int kExitStateInUse = 75;
+
 struct RunArgs {
   DdsCli dds;
   std::optional<std::uint32_t> mmsi;
@@ -189,6 +193,10 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   std::unique_ptr<service::FdiService> svc;
   try {
     svc = std::make_unique<service::FdiService>(cfg, log_line);
+  } catch (const service::StateInUse& e) {
+    // Not a word to the health file: it is the running sidecar's (same configuration).
+    spdlog::error("refusing to start: {}", e.what());
+    return kExitStateInUse;
   } catch (const std::exception& e) {
     spdlog::error("cannot start the DDS service: {}", e.what());
     health.write("failed", std::string("cannot start the DDS service: ") + e.what());

@@ -12,7 +12,9 @@ static_assert(kInputInsSilent == fdi::INPUT_INS_SILENT &&
                   kInputBadTimestamps == fdi::INPUT_BAD_TIMESTAMPS &&
                   kInputInvalidValues == fdi::INPUT_INVALID_VALUES &&
                   kInputGaps == fdi::INPUT_GAPS && kInputReordered == fdi::INPUT_REORDERED &&
-                  kInputQueueDrops == fdi::INPUT_QUEUE_DROPS,
+                  kInputQueueDrops == fdi::INPUT_QUEUE_DROPS &&
+                  kInputSamplesLost == fdi::INPUT_SAMPLES_LOST &&
+                  kInputOtherEventWriter == fdi::INPUT_OTHER_EVENT_WRITER,
               "InputFlag differs from idl/usv_fdi.idl INPUT_*");
 static_assert(kPauseNotArmed == fdi::PAUSE_NOT_ARMED && kPauseLearning == fdi::PAUSE_LEARNING &&
                   kPauseRudderMissing == fdi::PAUSE_RUDDER_MISSING &&

@@ -1,10 +1,21 @@
 #include "usv_fdi/dds_service/service.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <mutex>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -96,7 +107,14 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     }
   };
   auto on_status = [this, mmsi, iso](const PipelineStatus& s) {
-    dds::write(*status_writer_, to_dds(s, mmsi, iso));
+    fdi::FdiStatus d = to_dds(s, mmsi, iso);
+    if (watch_) {
+      if (watch_->recent(std::chrono::seconds(10))) {
+        d.input_flags(d.input_flags() | kInputOtherEventWriter);
+      }
+      d.other_event_writers(watch_->writers());
+    }
+    dds::write(*status_writer_, d);
   };
   pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, cfg_.pipeline, on_event, on_status, log_);
   for (const FaultEvent& e : restored_) pipeline_->restore(e);
@@ -116,9 +134,60 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   listener_->ins_ = &ins;
   listener_->rudder_ = &rudder;
   listener_->ack_ = &ack;
+  watch_ = std::make_unique<EventWatch>(mmsi, event_writer_->get_instance_handle(), log_);
+  event_watch_ = &dds_->create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
 }
 
-FdiService::~FdiService() { stop(); }
+FdiService::~FdiService() {
+  stop();
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the flock
+}
+
+bool FdiService::lock_state(const std::string& dir) {
+  const std::string path =
+      (std::filesystem::path(dir) / ("usv-fdi-" + std::to_string(cfg_.mmsi) + ".lock")).string();
+  const auto say = [this](int level, const std::string& msg) {
+    if (log_) log_(level, "state: " + msg);
+  };
+  const int fd =
+      ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY, 0640);
+  struct stat sb {};
+  if (fd < 0 || ::fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+    // Not a reason to refuse to start; the journal will say whether it can write.
+    say(2, "cannot use the lock file " + path + " (" +
+               (fd < 0 ? std::string(std::strerror(errno))
+                       : "it is " + StateJournal::file_type(sb.st_mode)) +
+               "): a second sidecar on this state directory would not be noticed");
+    if (fd >= 0) ::close(fd);
+    return false;
+  }
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char pid[32] = {0};
+    const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
+    ::close(fd);
+    std::string holder = n > 0 ? std::string(pid, static_cast<std::size_t>(n)) : "";
+    while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+    if (err == EWOULDBLOCK) {
+      throw StateInUse("the state directory " + dir + " is in use by another sidecar for MMSI " +
+                       std::to_string(cfg_.mmsi) +
+                       (holder.empty() ? std::string() : " (pid " + holder + ")") + ", lock " +
+                       path +
+                       ": two sidecars for one vessel would both publish its events and race "
+                       "on its state file; stop the other one, or give this one its own "
+                       "--state-dir");
+    }
+    say(2, "cannot lock " + path + ": " + std::strerror(err) +
+               ": a second sidecar on this state directory would not be noticed");
+    return false;
+  }
+  const std::string me = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, me.data(), me.size(), 0) < 0) {
+    say(2, "cannot write the pid to " + path + ": " + std::strerror(errno));
+  }
+  lock_fd_ = fd;
+  return true;
+}
 
 namespace {
 
@@ -159,6 +228,7 @@ void FdiService::open_journal() {
     }
     say(1, "created the state directory " + dir);
   }
+  lock_state(dir);  // throws StateInUse if another sidecar has it
   const std::string path = StateJournal::path_for(dir, cfg_.mmsi);
   journal_ = std::make_unique<StateJournal>(path, cfg_.mmsi);
   fs::remove(path + ".tmp", ec);  // a save interrupted by a crash; the file itself is whole
@@ -220,14 +290,17 @@ FdiService::Matches FdiService::matches() const {
     m.rudder_writers = sub.current_count;
   if (listener_->ack_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.ack_writers = sub.current_count;
+  // Not counting the sidecar's own EventWatch reader (same participant: matched at once).
   if (event_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
-    m.event_readers = pub.current_count;
+    m.event_readers = std::max(0, pub.current_count - (event_watch_ != nullptr ? 1 : 0));
   if (status_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
     m.status_readers = pub.current_count;
   return m;
 }
 
 std::uint64_t FdiService::foreign_samples() const { return listener_->foreign.load(); }
+std::uint64_t FdiService::other_event_writers() const { return watch_ ? watch_->writers() : 0; }
+std::uint64_t FdiService::other_event_samples() const { return watch_ ? watch_->samples() : 0; }
 
 void FdiService::start() {
   pipeline_->start();
@@ -235,12 +308,13 @@ void FdiService::start() {
   for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_}) {
     r->set_listener(listener_.get(), StatusMask::data_available());
   }
+  event_watch_->set_listener(watch_.get(), StatusMask::data_available());
 }
 
 void FdiService::stop() {
   if (stopped_) return;
   stopped_ = true;
-  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_}) {
+  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_, event_watch_}) {
     if (r != nullptr) r->set_listener(nullptr);
   }
   pipeline_->stop();  // drains the queues; the publisher thread writes the last events

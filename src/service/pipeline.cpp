@@ -115,7 +115,9 @@ std::string input_flag_names(std::uint32_t flags) {
                            {kInputInvalidValues, "invalid_values"},
                            {kInputGaps, "gaps"},
                            {kInputReordered, "reordered"},
-                           {kInputQueueDrops, "queue_drops"}});
+                           {kInputQueueDrops, "queue_drops"},
+                           {kInputSamplesLost, "samples_lost"},
+                           {kInputOtherEventWriter, "other_event_writer"}});
 }
 
 std::string pause_reason_names(std::uint32_t reasons) {

@@ -619,6 +619,8 @@ TEST(AckFlood, RefusedAcksAreCountedInBoundedLogAndDetectionIsUnchanged) {
   EXPECT_NE(log.find("more ack(s) refused in the last"), std::string::npos) << log.substr(0, 4000);
   EXPECT_NE(log.find("unknown sequence"), std::string::npos);
   EXPECT_LT(log.size(), 100000u + 200u * static_cast<std::size_t>(wall)) << log.substr(0, 4000);
+  // AND its own events were never taken for another writer's
+  EXPECT_EQ(log.find("ANOTHER WRITER"), std::string::npos) << log.substr(0, 4000);
   ASSERT_TRUE(svc.running());
   kill_and_reap(svc, SIGTERM, 0);
 }
@@ -721,6 +723,62 @@ TEST(BadInput, SamplesLostOnTheWayAreCountedFromTheSeqGapsAndFlagged) {
   // AND the samples that arrived were all processed (nothing dropped by the sidecar itself)
   ASSERT_FALSE(st.empty());
   EXPECT_EQ(st.back().dropped_inputs, 0u);
+  kill_and_reap(svc, SIGTERM, 0);
+}
+
+// ------------------------------------------------------------------ two sidecars, one MMSI
+
+TEST(TwoSidecarsOneMmsi, TheSecondOnTheSameStateDirectoryRefusesToStart) {
+  Fleet f;
+  const unsigned m = 257300014;
+  const std::string cfg = f.write_service_config("svc", m);
+  // GIVEN a running sidecar
+  ChildProcess& first = f.start_service("svc", cfg);
+  // WHEN a second one for the same MMSI and state directory starts
+  const auto code = f.run_to_end("second", {"run", "--config", cfg}, seconds(20));
+  // THEN it refuses at once (exit 75), naming the directory, the other pid and the remedy
+  ASSERT_TRUE(code.has_value()) << "the second sidecar runs\n" << f.log("second");
+  EXPECT_EQ(*code, 75) << f.log("second");
+  const std::string log = f.log("second");
+  EXPECT_NE(log.find("refusing to start: the state directory " + f.state_dir("svc") +
+                     " is in use by another sidecar for MMSI " + std::to_string(m) + " (pid " +
+                     std::to_string(first.pid()) + ")"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("--state-dir"), std::string::npos) << log;
+  // AND the first one runs on, undisturbed
+  ASSERT_TRUE(first.running());
+  kill_and_reap(first, SIGTERM, 0);
+  // AND once it has stopped, a sidecar may start on that directory again
+  ChildProcess& again = f.start_service("again", cfg);
+  ASSERT_TRUE(again.running()) << f.log("again");
+  kill_and_reap(again, SIGTERM, 0);
+}
+
+TEST(TwoSidecarsOneMmsi, AnotherWriterOfThisVesselsEventsIsReportedLoudly) {
+  Fleet f;
+  const unsigned m = 257300015;
+  const std::string cfg = f.write_service_config("svc", m, {"status_rate: 10"});
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  ChildProcess& svc = f.start_service("svc", cfg, 1);
+  // GIVEN another participant that writes FaultEvents of this vessel (a second sidecar on
+  // another state directory, or a forger)
+  f.start_probe(
+      "other", "publish-faults",
+      {"--vessels", "1", "--sensors", "2", "--mmsi-base", std::to_string(m), "--timeout", "60"});
+  // THEN the sidecar logs an error naming the other writer, and FdiStatus flags it
+  ASSERT_TRUE(f.wait_for_log("svc",
+                             "ANOTHER WRITER publishes FaultEvents of this vessel (MMSI " +
+                                 std::to_string(m) + "): writer ",
+                             seconds(20)))
+      << f.log("svc");
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  EXPECT_TRUE(read_monitor_until(
+      control, &ev, &st, seconds(15),
+      [&](const auto&) { return !st.empty() && st.back().has_flag("other_event_writer"); }, &err))
+      << err << f.log("svc");
   kill_and_reap(svc, SIGTERM, 0);
 }
 

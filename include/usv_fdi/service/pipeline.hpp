@@ -116,6 +116,10 @@ enum InputFlag : std::uint32_t {
   kInputGaps = 1u << 6,           ///< gaps between INS samples longer than stale_timeout
   kInputReordered = 1u << 7,      ///< samples delivered out of order (re-sorted)
   kInputQueueDrops = 1u << 8,     ///< input queue overflow: oldest samples dropped
+  kInputSamplesLost = 1u << 9,    ///< gaps in the sources' seq: samples lost before the sidecar
+  /// Set by the DDS service, not the pipeline: another DDS writer published this vessel's
+  /// FaultEvents within the last 10 s (a second sidecar with the same MMSI, or a forger).
+  kInputOtherEventWriter = 1u << 10,
 };
 
 /// Why identification or isolation is paused (PipelineStatus::identification_paused,
