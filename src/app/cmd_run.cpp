@@ -205,10 +205,10 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   svc->start();
   health.write("running", "", svc.get());
   spdlog::info(
-      "sidecar for MMSI {} on DDS domain {} (participant profile {}, QoS {}, {} inputs, "
-      "status every {:g} s, state {}, health file {}): waiting for INS and rudder",
-      cfg.mmsi, cfg.dds.domain_id, cfg.dds.participant_profile, cfg.dds.profiles_file,
-      cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", period,
+      "sidecar for MMSI {} (incarnation {}) on DDS domain {} (participant profile {}, QoS {}, "
+      "{} inputs, status every {:g} s, state {}, health file {}): waiting for INS and rudder",
+      cfg.mmsi, svc->incarnation(), cfg.dds.domain_id, cfg.dds.participant_profile,
+      cfg.dds.profiles_file, cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", period,
       svc->state_file().empty() ? std::string("not persisted") : svc->state_file(),
       cfg.health_file.empty() ? std::string("none") : cfg.health_file);
   int sig = 0;

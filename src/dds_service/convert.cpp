@@ -37,6 +37,7 @@ fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {
   d.detection_time(e.detection_time);
   d.stamp(e.t);
   d.sequence(e.sequence);
+  d.incarnation(e.incarnation);
   d.a({e.A(0, 0), e.A(0, 1), e.A(1, 0), e.A(1, 1)});
   d.message(e.message.substr(0, 127).c_str());
   return d;
@@ -60,6 +61,7 @@ bool from_dds(const fdi::FaultEvent& d, FaultEvent* out) {
   e.detection_time = d.detection_time();
   e.t = d.stamp();
   e.sequence = d.sequence();
+  e.incarnation = d.incarnation();
   e.A << d.a()[0], d.a()[1], d.a()[2], d.a()[3];
   e.message = d.message().to_string();
   *out = e;
@@ -90,6 +92,11 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   d.gaps(s.gaps);
   d.reordered(s.reordered);
   d.dropped_inputs(s.dropped_inputs);
+  d.lost_ins(s.lost_ins);
+  d.lost_rudder(s.lost_rudder);
+  d.acks_refused(s.acks_refused);
+  d.acks_dropped(s.acks_dropped);
+  d.incarnation(s.incarnation);
   d.identification_paused(s.identification_paused);
   d.isolation_paused(s.isolation_paused);
   std::string msg;
@@ -126,6 +133,7 @@ AckInput from_dds(const fdi::FaultAck& a) {
   out.sensor = static_cast<Sensor>(a.sensor());
   out.sequence = a.sequence();
   out.who = a.operator_id().to_string();
+  out.incarnation = a.incarnation();
   return out;
 }
 

@@ -85,8 +85,8 @@ std::string text(const YAML::Node& n, const std::string& key) {
 FaultEvent instance(const YAML::Node& n) {
   if (!n.IsMap()) throw Bad(where(n) + ": an instance must be an object");
   static const std::set<std::string> keys = {
-      "sensor",    "state",          "kind",  "sequence", "c_a",     "c_g",       "statistic",
-      "threshold", "detection_time", "stamp", "a",        "message", "onset_time"};
+      "sensor",    "state",          "kind",  "sequence", "c_a",     "c_g",        "statistic",
+      "threshold", "detection_time", "stamp", "a",        "message", "onset_time", "incarnation"};
   for (const auto& kv : n) {
     if (!keys.count(kv.first.Scalar())) {
       throw Bad(where(kv.first) + ": unknown field \"" + kv.first.Scalar() + "\"");
@@ -113,6 +113,10 @@ FaultEvent instance(const YAML::Node& n) {
   if (!a.IsSequence() || a.size() != 4) throw Bad(where(a) + ": \"a\" must be a list of 4 numbers");
   for (int i = 0; i < 4; ++i) e.A(i / 2, i % 2) = real(a[i], "a");
   e.message = text(need(n, "message", ctx), "message");
+  // Optional: files written before incarnations existed have none (0).
+  for (const auto& kv : n) {
+    if (kv.first.Scalar() == "incarnation") e.incarnation = integer(kv.second, "incarnation");
+  }
   return e;
 }
 
@@ -143,9 +147,10 @@ std::string StateJournal::serialise(std::uint32_t mmsi, const std::vector<FaultE
     s += i == 0 ? "\n" : ",\n";
     s += "    {\"sensor\": \"" + std::string(to_string(e.sensor)) + "\", \"state\": \"" +
          to_string(e.state) + "\", \"kind\": \"" + to_string(e.kind) +
-         "\", \"sequence\": " + std::to_string(e.sequence) + ",\n     \"c_a\": " + number(e.c_a) +
-         ", \"c_g\": " + number(e.c_g) + ", \"statistic\": " + number(e.statistic) +
-         ", \"threshold\": " + number(e.threshold) +
+         "\", \"sequence\": " + std::to_string(e.sequence) +
+         ", \"incarnation\": " + std::to_string(e.incarnation) +
+         ",\n     \"c_a\": " + number(e.c_a) + ", \"c_g\": " + number(e.c_g) +
+         ", \"statistic\": " + number(e.statistic) + ", \"threshold\": " + number(e.threshold) +
          ",\n     \"onset_time\": " + number(e.onset_time) +
          ", \"detection_time\": " + number(e.detection_time) + ", \"stamp\": " + number(e.t) +
          ",\n     \"a\": [" + number(e.A(0, 0)) + ", " + number(e.A(0, 1)) + ", " +

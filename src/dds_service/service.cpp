@@ -73,6 +73,78 @@ class FdiService::Listener : public DataReaderListener {
   std::uint32_t mmsi_;
 };
 
+/// Watches the FaultEvent topic for this vessel's instances written by anyone but this
+/// sidecar: a second sidecar with the same MMSI (every event would reach the monitors twice)
+/// or a forger. Says so loudly: an error line per new writer, then a count every 10 s while
+/// it goes on; the status carries a flag and the count.
+class FdiService::EventWatch : public DataReaderListener {
+ public:
+  EventWatch(std::uint32_t mmsi, eprosima::fastdds::dds::InstanceHandle_t own,
+             FdiService::LogSink log)
+      : mmsi_(mmsi), own_(own), log_(std::move(log)) {}
+  void on_data_available(DataReader* reader) override {
+    fdi::FaultEvent e;
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || e.mmsi() != mmsi_ || info.publication_handle == own_) continue;
+      std::ostringstream guid;
+      guid << info.publication_handle;
+      const auto now = std::chrono::steady_clock::now();
+      std::string line;
+      {
+        std::lock_guard<std::mutex> lock(m_);
+        ++samples_;
+        last_seen_ = now;
+        seen_any_ = true;
+        if (writers_.insert(guid.str()).second) {
+          line = "ANOTHER WRITER publishes FaultEvents of this vessel (MMSI " +
+                 std::to_string(mmsi_) + "): writer " + guid.str() + " wrote " +
+                 sensor_name(e.sensor()) + " #" + std::to_string(e.sequence()) + " (incarnation " +
+                 std::to_string(e.incarnation()) +
+                 "): a second sidecar for this MMSI, or a forger; monitors cannot tell its "
+                 "events from this sidecar's (" +
+                 std::to_string(writers_.size()) + " other writer(s) so far)";
+          last_logged_ = now;
+          logged_samples_ = samples_;
+        } else if (now - last_logged_ >= std::chrono::seconds(10)) {
+          line = "ANOTHER WRITER still publishes FaultEvents of MMSI " + std::to_string(mmsi_) +
+                 ": " + std::to_string(samples_ - logged_samples_) + " more sample(s) from " +
+                 std::to_string(writers_.size()) + " other writer(s)";
+          last_logged_ = now;
+          logged_samples_ = samples_;
+        }
+      }
+      if (!line.empty() && log_) log_(3, line);
+    }
+  }
+  std::uint64_t writers() const {
+    std::lock_guard<std::mutex> lock(m_);
+    return writers_.size();
+  }
+  std::uint64_t samples() const {
+    std::lock_guard<std::mutex> lock(m_);
+    return samples_;
+  }
+  /// True while another writer has written within `window`.
+  bool recent(std::chrono::steady_clock::duration window) const {
+    std::lock_guard<std::mutex> lock(m_);
+    return seen_any_ && std::chrono::steady_clock::now() - last_seen_ <= window;
+  }
+
+ private:
+  static std::string sensor_name(std::uint8_t s) {
+    return s <= 2 ? to_string(static_cast<Sensor>(s)) : "sensor " + std::to_string(s);
+  }
+  std::uint32_t mmsi_;
+  eprosima::fastdds::dds::InstanceHandle_t own_;
+  FdiService::LogSink log_;
+  mutable std::mutex m_;
+  std::set<std::string> writers_;
+  std::uint64_t samples_ = 0, logged_samples_ = 0;
+  bool seen_any_ = false;
+  std::chrono::steady_clock::time_point last_seen_{}, last_logged_{};
+};
+
 FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(std::move(log)) {
   if (cfg_.mmsi == 0) throw std::invalid_argument("service.mmsi must be set (a vessel's MMSI > 0)");
   dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
@@ -116,7 +188,19 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     }
     dds::write(*status_writer_, d);
   };
-  pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, cfg_.pipeline, on_event, on_status, log_);
+  // This run's incarnation: its start time (microseconds since the Unix epoch), above that
+  // of every restored event even if the clock went back.
+  PipelineOptions popt = cfg_.pipeline;
+  if (popt.incarnation == 0) {
+    std::uint64_t floor = 0;
+    for (const FaultEvent& e : restored_) floor = std::max(floor, e.incarnation);
+    const auto now_us =
+        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count());
+    popt.incarnation = std::max(now_us, floor + 1);
+  }
+  pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, popt, on_event, on_status, log_);
   for (const FaultEvent& e : restored_) pipeline_->restore(e);
   listener_ = std::make_unique<Listener>(pipeline_.get(), mmsi);
   DataReader& ins = dds_->create_reader(dds::TopicId::kIns,

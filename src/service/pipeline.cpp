@@ -170,7 +170,9 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       iso_(cfg.isolation, cfg.B),
       assembler_(opt.rudder_wait, opt.rudder_timeout),
       ident_(cfg.identification, cfg.B),
-      gate_(cfg.identification_delay) {}
+      gate_(cfg.identification_delay) {
+  incarnation_ = opt.incarnation;
+}
 
 FdiPipeline::~FdiPipeline() { stop(); }
 
@@ -180,6 +182,7 @@ void FdiPipeline::restore(const FaultEvent& ev) {
   if (i < 0 || i > 2) throw std::invalid_argument("FdiPipeline::restore(): unknown sensor");
   latches_[i].restore(ev);
   restored_.push_back(ev);
+  current_incarnation_[i] = ev.incarnation;
   {
     std::lock_guard<std::mutex> lock(latest_m_);
     latest_[i] = ev;
@@ -223,7 +226,10 @@ void FdiPipeline::log(int level, const std::string& msg) const {
   if (on_log_) on_log_(level, msg);
 }
 
-void FdiPipeline::emit(const FaultEvent& ev) {
+void FdiPipeline::emit(const FaultEvent& ev_in, bool restored) {
+  FaultEvent ev = ev_in;
+  if (!restored && incarnation_ != 0) ev.incarnation = incarnation_;
+  current_incarnation_[index_of(ev.sensor)] = ev.incarnation;
   {
     std::lock_guard<std::mutex> lock(latest_m_);
     latest_[index_of(ev.sensor)] = ev;
@@ -411,6 +417,17 @@ void FdiPipeline::handle_ack(const AckInput& a) {
   }
   FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
   const std::uint64_t current = latch.current().sequence;
+  const std::uint64_t inc = current_incarnation_[static_cast<int>(a.sensor)];
+  if (incarnation_ != 0 && a.incarnation != inc) {
+    // Sequences start again in a new run without a state directory: an ack of another run's
+    // event must not acknowledge this run's event of the same number.
+    refuse_ack(a, "other incarnation",
+               what + " refused: incarnation " + std::to_string(a.incarnation) +
+                   " is not that of the current event (#" + std::to_string(current) +
+                   ", incarnation " + std::to_string(inc) + "): it acknowledges an event of " +
+                   (a.incarnation < inc ? "an earlier" : "another") + " run of the sidecar");
+    return;
+  }
   // Stamp: the time of the last sample (before any sample after a restart: the event's own).
   const double t = std::isfinite(last_t_) ? last_t_ : latch.current().t;
   const AckResult r = latch.acknowledge(a.sequence, t, a.who, &ev);
@@ -533,6 +550,10 @@ PipelineStatus FdiPipeline::make_status() {
   if (!st.isolation.observer_problem.empty()) iso |= kPauseObserver;
   st.identification_paused = id;
   st.isolation_paused = iso;
+  st.acks_accepted = acks_accepted_.load();
+  st.acks_refused = acks_refused_.load();
+  st.acks_dropped = acks_.dropped();
+  st.incarnation = incarnation_;
   return st;
 }
 

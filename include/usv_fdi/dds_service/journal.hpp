@@ -17,13 +17,17 @@
 //     "mmsi": 257000001,
 //     "written": 1732370000.123,
 //     "instances": [
-//       {"sensor": "gyro", "state": "raised", "kind": "bias", "sequence": 3, "c_a": 0.01,
+//       {"sensor": "gyro", "state": "raised", "kind": "bias", "sequence": 3,
+//        "incarnation": 1764624000123456, "c_a": 0.01,
 //        "c_g": 0.99, "statistic": 14.1, "threshold": 6, "onset_time": 20, "detection_time": 20.4,
 //        "stamp": 20.4, "a": [-0.1, 0.2, 0.3, -0.4], "message": "..."}
 //     ],
 //     "checksum": "fnv1a64:0123456789abcdef"
 //   }
 // Numbers are written with 17 significant digits (exact round trip); NaN as null.
+// "incarnation" (the sidecar run that issued the sequence) may be missing (files written
+// before it existed): 0. A file that is not a regular file (a FIFO, a directory) is refused
+// without blocking.
 #pragma once
 
 #include <array>

@@ -67,6 +67,8 @@ class FdiService {
   /// Idempotent; the destructor calls it.
   void stop();
   PipelineStatus status() const { return pipeline_->status(); }
+  /// This run's incarnation (FaultEvent.incarnation of the events it issues).
+  std::uint64_t incarnation() const { return pipeline_->incarnation(); }
   PipelineLiveness liveness() const { return pipeline_->liveness(); }
 
   /// The state journal's file ("" when state is not persisted) and the error of its last

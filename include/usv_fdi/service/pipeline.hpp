@@ -52,6 +52,7 @@ struct AckInput {
   Sensor sensor = Sensor::kUnknown;
   std::uint64_t sequence = 0;
   std::string who;
+  std::uint64_t incarnation = 0;  ///< FaultEvent::incarnation of the acknowledged event
 };
 
 /// Pairs INS samples with the rudder angle at the same source time: linear interpolation
@@ -101,6 +102,15 @@ struct PipelineOptions {
   bool lockstep = false;
   /// Operators allowed to acknowledge (empty: anyone who can write the ack topic).
   std::vector<std::string> authorised_operators;
+  /// Refused acks are logged in full 5 times per this period (wall clock) [s] at most, the
+  /// others in one summary line at its end (counts by reason, an example).
+  double ack_log_period = 5.0;
+  /// This run's incarnation, carried by every event it issues (FaultEvent::incarnation):
+  /// (incarnation, sequence) never repeats across restarts, and an ack must name the
+  /// incarnation of the event it acknowledges. The sidecar sets its start time, microseconds
+  /// since the Unix epoch (above every restored event's). 0: no incarnations (replay, tests):
+  /// events keep theirs and acks are not checked for one.
+  std::uint64_t incarnation = 0;
 };
 
 /// Input problems (PipelineStatus::input_flags). The values are those of the INPUT_*
@@ -161,6 +171,11 @@ struct PipelineStatus {
   std::uint64_t lost_ins = 0, lost_rudder = 0;
   std::uint32_t identification_paused = 0;  ///< PauseReason bits (0: identifying)
   std::uint32_t isolation_paused = 0;       ///< PauseReason bits (0: detecting)
+  // Operator acknowledgements since start.
+  std::uint64_t acks_accepted = 0;
+  std::uint64_t acks_refused = 0;  ///< unauthorised, unknown sensor, stale or unknown sequence...
+  std::uint64_t acks_dropped = 0;  ///< ack queue overflow (a flood), oldest dropped
+  std::uint64_t incarnation = 0;   ///< this run (PipelineOptions::incarnation)
 };
 
 /// Wall-clock seconds since each thread last went round its loop (an idle thread still goes
@@ -211,6 +226,24 @@ class FdiPipeline {
   bool push_ack(const AckInput& a) { return acks_.push(a); }
 
   PipelineStatus status() const;
+  /// The incarnation of this run (see PipelineOptions::incarnation).
+  std::uint64_t incarnation() const { return incarnation_; }
+
+  /// Gaps in a stream's sample numbers (lock-free: listeners may call from several threads).
+  /// The first number seen starts the count; a number more than kRestartWindow below the
+  /// highest is taken as the source restarting its count (not a loss); one below it but
+  /// within the window is a late sample of a gap, taken off the count.
+  class SeqGaps {
+   public:
+    static constexpr std::uint64_t kRestartWindow = 1000;
+    void see(std::uint64_t seq);
+    std::uint64_t lost() const { return lost_.load(std::memory_order_relaxed); }
+    std::uint64_t restarts() const { return restarts_.load(std::memory_order_relaxed); }
+
+   private:
+    std::atomic<std::uint64_t> highest_{0}, lost_{0}, restarts_{0};
+  };
+
   /// For a health check: how recently each thread went round its loop.
   PipelineLiveness liveness() const;
 
@@ -259,7 +292,9 @@ class FdiPipeline {
   void accept_rudder(const RudderInput& in);
   void process(const Sample& s);
   void recheck_restored(const Sample& s);
-  void emit(const FaultEvent& ev);
+  /// Hands an event of this run (stamped with its incarnation) to the output queue;
+  /// restored = true: a restored event, re-published with the incarnation that issued it.
+  void emit(const FaultEvent& ev, bool restored = false);
   void publish(const FaultEvent& ev);
   void publish_latest();
   void handle_ack(const AckInput& a);
@@ -287,6 +322,9 @@ class FdiPipeline {
                                      FaultLatch(Sensor::kUnknown)};
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
+  std::uint64_t incarnation_ = 0;
+  /// The incarnation of each instance's current event (isolation thread): an ack must name it.
+  std::array<std::uint64_t, 3> current_incarnation_{0, 0, 0};
   std::array<Recheck, 3> recheck_{};
   double last_t_ = kNaN;
   double newest_ins_stamp_ = -1e300;
