@@ -374,9 +374,19 @@ FdiService::Matches FdiService::matches() const {
     m.rudder_writers = sub.current_count;
   if (listener_->ack_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.ack_writers = sub.current_count;
-  // Not counting the sidecar's own EventWatch reader (same participant: matched at once).
-  if (event_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
-    m.event_readers = std::max(0, pub.current_count - (event_watch_ != nullptr ? 1 : 0));
+  // Subscribers other than sidecars: not this sidecar's own EventWatch reader (same
+  // participant, matched at once), nor those of the other sidecars on the domain. Fast DDS 2.9
+  // cannot list matched readers, so the other sidecars are counted as the FaultEvent writers
+  // the EventWatch reader has matched besides this sidecar's own (each sidecar has one writer
+  // and one watch reader).
+  if (event_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK) {
+    int others = 0;
+    if (event_watch_ != nullptr &&
+        event_watch_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK) {
+      others = std::max(0, sub.current_count - 1);
+    }
+    m.event_readers = std::max(0, pub.current_count - (event_watch_ != nullptr ? 1 : 0) - others);
+  }
   if (status_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
     m.status_readers = pub.current_count;
   return m;
