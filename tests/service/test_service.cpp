@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "../dds/starvation.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
@@ -366,6 +367,7 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
   std::this_thread::sleep_for(milliseconds(700));
   // WHEN it stops (listeners detached, queues shut down, threads joined, DDS entities
   // deleted) while the writers keep going
+  usv_fdi::dds::test::StarvationMeter meter;
   const auto t0 = Clock::now();
   svc->stop();
   const double took = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -374,8 +376,9 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
   go = false;
   ta.join();
   tb.join();
-  // THEN it was done well within 2 s and had been working
-  EXPECT_LT(took, 2.0);
+  // THEN it was done within 2 s (plus what the machine's starvation explains) and had been
+  // working
+  EXPECT_LT(took, meter.limit(2.0)) << meter.report();
   EXPECT_GT(st.samples + st.rejected + st.dropped_inputs, 100u);
   std::printf("stop() took %.3f s; %llu samples, %llu rejected, %llu dropped\n", took,
               static_cast<unsigned long long>(st.samples),
