@@ -67,7 +67,7 @@ class StateJournal {
   enum class LoadResult : std::uint8_t { kLoaded, kMissing, kError };
   /// Reads the file at `path`. kMissing: no such file (a first start). kError: *error names
   /// the file and what was wrong (unreadable, not a regular file, not JSON, wrong version or
-  /// MMSI, checksum ...). Never blocks: a FIFO or device at `path` is refused unopened-for-I/O.
+  /// MMSI, checksum ...). Never blocks: a FIFO or device at `path` is refused without reading.
   static LoadResult load(const std::string& path, std::uint32_t mmsi, Contents* out,
                          std::string* error);
 
