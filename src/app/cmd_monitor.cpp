@@ -500,6 +500,7 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
                             to_string(static_cast<Sensor>(ack.sensor())) + " #" +
                             std::to_string(ack.sequence());
     ack.stamp(wall_now());
+    if (row != nullptr) ack.incarnation(row->ev.incarnation);  // else refused by the sidecar
     dds::write(w, ack);
     spdlog::info("ack sent: {} by {}", who, a.operator_id);
     // Confirmed when the instance moves from the acknowledged sequence past it, to an

@@ -1,4 +1,5 @@
 // usv-fdi run: the FDI sidecar of one vessel on Fast DDS.
+#include <spdlog/async.h>
 #include <spdlog/spdlog.h>
 
 #include <unistd.h>
@@ -8,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "commands.hpp"
 #include "dds_options.hpp"
@@ -17,6 +19,10 @@
 
 namespace usvfdi::app {
 namespace {
+
+/// Exit code when another sidecar holds the state directory's lock for this MMSI
+/// (EX_TEMPFAIL: it may start once the other one has stopped). Documented in docs/dds.md.
+constexpr int kExitStateInUse = 75;
 
 struct RunArgs {
   DdsCli dds;
@@ -84,6 +90,54 @@ class HealthWriter {
   std::string logged_error_, logged_failure_;
 };
 
+/// The sidecar logs through spdlog's asynchronous logger: every thread (the pipeline's, Fast
+/// DDS's, the main one waiting for SIGTERM) only puts the line in a bounded queue; one
+/// logging thread writes stderr. When stderr is not read (a pipe nobody drains), that thread
+/// blocks in write(2) and the queue overflows, dropping its oldest lines (counted): detection,
+/// publishing and the reaction to signals go on. At exit the queue is given a bounded time to
+/// drain; if stderr still does not take it, the process exits without waiting for it.
+class AsyncLogging {
+ public:
+  static constexpr std::size_t kQueue = 8192;  ///< lines
+
+  AsyncLogging() : sync_(spdlog::default_logger()) {
+    pool_ = std::make_shared<spdlog::details::thread_pool>(kQueue, 1);
+    auto logger = std::make_shared<spdlog::async_logger>(
+        sync_->name(), sync_->sinks().begin(), sync_->sinks().end(), pool_,
+        spdlog::async_overflow_policy::overrun_oldest);
+    logger->set_level(sync_->level());
+    spdlog::set_default_logger(logger);
+  }
+  /// Lines dropped because the queue was full.
+  std::size_t dropped() const { return pool_->overrun_counter(); }
+  /// Waits (at most `timeout` s) until the queue is written, then goes back to the
+  /// synchronous logger. False: stderr does not take it (the caller must not wait for the
+  /// logging thread: it exits with _exit).
+  bool finish(double timeout) {
+    const auto end = std::chrono::steady_clock::now() +
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(timeout));
+    while (pool_->queue_size() > 0) {
+      if (std::chrono::steady_clock::now() >= end) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    const spdlog::level::level_enum level = spdlog::default_logger()->level();
+    spdlog::default_logger()->flush();  // queued behind the last line
+    while (pool_->queue_size() > 0) {
+      if (std::chrono::steady_clock::now() >= end) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    sync_->set_level(level);
+    spdlog::set_default_logger(sync_);
+    pool_.reset();  // joins the logging thread, which has written everything
+    return true;
+  }
+
+ private:
+  std::shared_ptr<spdlog::logger> sync_;
+  std::shared_ptr<spdlog::details::thread_pool> pool_;
+};
+
 void log_line(int level, const std::string& msg) {
   switch (level) {
     case 0:
@@ -101,7 +155,7 @@ void log_line(int level, const std::string& msg) {
   }
 }
 
-int run_service(const RunArgs& a) {
+int run_service(const RunArgs& a, const AsyncLogging& logging) {
   // SIGINT/SIGTERM are blocked before any DDS or pipeline thread exists and received with
   // sigtimedwait below: no signal handler, so nothing runs in signal context.
   block_stop_signals();
@@ -139,6 +193,10 @@ int run_service(const RunArgs& a) {
   std::unique_ptr<service::FdiService> svc;
   try {
     svc = std::make_unique<service::FdiService>(cfg, log_line);
+  } catch (const service::StateInUse& e) {
+    // Not a word to the health file: it is the running sidecar's (same configuration).
+    spdlog::error("refusing to start: {}", e.what());
+    return kExitStateInUse;
   } catch (const std::exception& e) {
     spdlog::error("cannot start the DDS service: {}", e.what());
     health.write("failed", std::string("cannot start the DDS service: ") + e.what());
@@ -147,10 +205,10 @@ int run_service(const RunArgs& a) {
   svc->start();
   health.write("running", "", svc.get());
   spdlog::info(
-      "sidecar for MMSI {} on DDS domain {} (participant profile {}, QoS {}, {} inputs, "
-      "status every {:g} s, state {}, health file {}): waiting for INS and rudder",
-      cfg.mmsi, cfg.dds.domain_id, cfg.dds.participant_profile, cfg.dds.profiles_file,
-      cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", period,
+      "sidecar for MMSI {} (incarnation {}) on DDS domain {} (participant profile {}, QoS {}, "
+      "{} inputs, status every {:g} s, state {}, health file {}): waiting for INS and rudder",
+      cfg.mmsi, svc->incarnation(), cfg.dds.domain_id, cfg.dds.participant_profile,
+      cfg.dds.profiles_file, cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", period,
       svc->state_file().empty() ? std::string("not persisted") : svc->state_file(),
       cfg.health_file.empty() ? std::string("none") : cfg.health_file);
   int sig = 0;
@@ -178,10 +236,22 @@ int run_service(const RunArgs& a) {
   const PipelineStatus st = svc->status();
   spdlog::info(
       "stopped in {:.3f} s ({} samples, {} rejected, dropped: {} input, {} identification, {} "
-      "output; {} samples of other vessels skipped)",
+      "output; {} samples of other vessels skipped; {} log lines dropped)",
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), st.samples,
-      st.rejected, st.dropped_inputs, st.dropped_ident, st.dropped_output, svc->foreign_samples());
+      st.rejected, st.dropped_inputs, st.dropped_ident, st.dropped_output, svc->foreign_samples(),
+      logging.dropped());
   return kExitOk;
+}
+
+/// Seconds the log queue may take to reach stderr at exit.
+constexpr double kLogDrainAtExit = 2.0;
+
+int run_service_logged(const RunArgs& a) {
+  AsyncLogging logging;
+  const int code = run_service(a, logging);
+  // Everything is stopped and saved; only the log may be stuck behind an unread stderr.
+  if (!logging.finish(kLogDrainAtExit)) ::_exit(code);
+  return code;
 }
 
 }  // namespace
@@ -190,7 +260,7 @@ void register_run_command(CommandRegistry& registry) {
   static RunArgs args;
   args.root = &registry.root();
   CLI::App* sub = registry.add("run", "run the FDI sidecar of one vessel on Fast DDS",
-                               [] { return run_service(args); });
+                               [] { return run_service_logged(args); });
   add_dds_options(sub, &args.dds);
   sub->get_option("--config")->required();
   sub->add_option("--mmsi", args.mmsi, "the vessel's MMSI (overrides service.mmsi)")

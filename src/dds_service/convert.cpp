@@ -12,7 +12,9 @@ static_assert(kInputInsSilent == fdi::INPUT_INS_SILENT &&
                   kInputBadTimestamps == fdi::INPUT_BAD_TIMESTAMPS &&
                   kInputInvalidValues == fdi::INPUT_INVALID_VALUES &&
                   kInputGaps == fdi::INPUT_GAPS && kInputReordered == fdi::INPUT_REORDERED &&
-                  kInputQueueDrops == fdi::INPUT_QUEUE_DROPS,
+                  kInputQueueDrops == fdi::INPUT_QUEUE_DROPS &&
+                  kInputSamplesLost == fdi::INPUT_SAMPLES_LOST &&
+                  kInputOtherEventWriter == fdi::INPUT_OTHER_EVENT_WRITER,
               "InputFlag differs from idl/usv_fdi.idl INPUT_*");
 static_assert(kPauseNotArmed == fdi::PAUSE_NOT_ARMED && kPauseLearning == fdi::PAUSE_LEARNING &&
                   kPauseRudderMissing == fdi::PAUSE_RUDDER_MISSING &&
@@ -35,6 +37,7 @@ fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {
   d.detection_time(e.detection_time);
   d.stamp(e.t);
   d.sequence(e.sequence);
+  d.incarnation(e.incarnation);
   d.a({e.A(0, 0), e.A(0, 1), e.A(1, 0), e.A(1, 1)});
   d.message(e.message.substr(0, 127).c_str());
   return d;
@@ -58,6 +61,7 @@ bool from_dds(const fdi::FaultEvent& d, FaultEvent* out) {
   e.detection_time = d.detection_time();
   e.t = d.stamp();
   e.sequence = d.sequence();
+  e.incarnation = d.incarnation();
   e.A << d.a()[0], d.a()[1], d.a()[2], d.a()[3];
   e.message = d.message().to_string();
   *out = e;
@@ -88,6 +92,11 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   d.gaps(s.gaps);
   d.reordered(s.reordered);
   d.dropped_inputs(s.dropped_inputs);
+  d.lost_ins(s.lost_ins);
+  d.lost_rudder(s.lost_rudder);
+  d.acks_refused(s.acks_refused);
+  d.acks_dropped(s.acks_dropped);
+  d.incarnation(s.incarnation);
   d.identification_paused(s.identification_paused);
   d.isolation_paused(s.isolation_paused);
   std::string msg;
@@ -105,16 +114,18 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   }
   if (s.identification_paused & kPauseFault) msg += "identification frozen (fault); ";
   if (s.rejected > 0) msg += std::to_string(s.rejected) + " samples rejected; ";
+  if (s.lost_ins + s.lost_rudder > 0)
+    msg += std::to_string(s.lost_ins + s.lost_rudder) + " samples lost; ";
   d.message(msg.substr(0, 127).c_str());
   return d;
 }
 
 InsInput from_dds(const fdi::InsSample& s) {
-  return InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid()};
+  return InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid(), s.seq()};
 }
 
 RudderInput from_dds(const fdi::RudderSample& s) {
-  return RudderInput{s.stamp(), s.delta(), s.valid()};
+  return RudderInput{s.stamp(), s.delta(), s.valid(), s.seq()};
 }
 
 AckInput from_dds(const fdi::FaultAck& a) {
@@ -122,6 +133,7 @@ AckInput from_dds(const fdi::FaultAck& a) {
   out.sensor = static_cast<Sensor>(a.sensor());
   out.sequence = a.sequence();
   out.who = a.operator_id().to_string();
+  out.incarnation = a.incarnation();
   return out;
 }
 

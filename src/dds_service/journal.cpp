@@ -85,8 +85,8 @@ std::string text(const YAML::Node& n, const std::string& key) {
 FaultEvent instance(const YAML::Node& n) {
   if (!n.IsMap()) throw Bad(where(n) + ": an instance must be an object");
   static const std::set<std::string> keys = {
-      "sensor",    "state",          "kind",  "sequence", "c_a",     "c_g",       "statistic",
-      "threshold", "detection_time", "stamp", "a",        "message", "onset_time"};
+      "sensor",    "state",          "kind",  "sequence", "c_a",     "c_g",        "statistic",
+      "threshold", "detection_time", "stamp", "a",        "message", "onset_time", "incarnation"};
   for (const auto& kv : n) {
     if (!keys.count(kv.first.Scalar())) {
       throw Bad(where(kv.first) + ": unknown field \"" + kv.first.Scalar() + "\"");
@@ -113,6 +113,10 @@ FaultEvent instance(const YAML::Node& n) {
   if (!a.IsSequence() || a.size() != 4) throw Bad(where(a) + ": \"a\" must be a list of 4 numbers");
   for (int i = 0; i < 4; ++i) e.A(i / 2, i % 2) = real(a[i], "a");
   e.message = text(need(n, "message", ctx), "message");
+  // Optional: files written before incarnations existed have none (0).
+  for (const auto& kv : n) {
+    if (kv.first.Scalar() == "incarnation") e.incarnation = integer(kv.second, "incarnation");
+  }
   return e;
 }
 
@@ -143,9 +147,10 @@ std::string StateJournal::serialise(std::uint32_t mmsi, const std::vector<FaultE
     s += i == 0 ? "\n" : ",\n";
     s += "    {\"sensor\": \"" + std::string(to_string(e.sensor)) + "\", \"state\": \"" +
          to_string(e.state) + "\", \"kind\": \"" + to_string(e.kind) +
-         "\", \"sequence\": " + std::to_string(e.sequence) + ",\n     \"c_a\": " + number(e.c_a) +
-         ", \"c_g\": " + number(e.c_g) + ", \"statistic\": " + number(e.statistic) +
-         ", \"threshold\": " + number(e.threshold) +
+         "\", \"sequence\": " + std::to_string(e.sequence) +
+         ", \"incarnation\": " + std::to_string(e.incarnation) +
+         ",\n     \"c_a\": " + number(e.c_a) + ", \"c_g\": " + number(e.c_g) +
+         ", \"statistic\": " + number(e.statistic) + ", \"threshold\": " + number(e.threshold) +
          ",\n     \"onset_time\": " + number(e.onset_time) +
          ", \"detection_time\": " + number(e.detection_time) + ", \"stamp\": " + number(e.t) +
          ",\n     \"a\": [" + number(e.A(0, 0)) + ", " + number(e.A(0, 1)) + ", " +
@@ -216,12 +221,34 @@ bool StateJournal::parse(const std::string& text_in, std::uint32_t mmsi, Content
   return false;
 }
 
+std::string StateJournal::file_type(unsigned mode) {
+  if (S_ISREG(mode)) return "a regular file";
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
+}
+
 StateJournal::LoadResult StateJournal::load(const std::string& path, std::uint32_t mmsi,
                                             Contents* out, std::string* error) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO (or a device) must not wait for a writer; only a regular file
+  // is read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
   if (fd < 0) {
     if (errno == ENOENT) return LoadResult::kMissing;
     *error = path + ": cannot open: " + std::strerror(errno);
+    return LoadResult::kError;
+  }
+  struct stat sb {};
+  if (::fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+    *error = path + ": " +
+             (S_ISREG(sb.st_mode)
+                  ? std::string("cannot stat: ") + std::strerror(errno)
+                  : "is " + file_type(sb.st_mode) + ", not a state file (a regular file)");
+    ::close(fd);
     return LoadResult::kError;
   }
   std::string text;
@@ -260,7 +287,10 @@ bool StateJournal::write_atomic(const std::string& path, const std::string& text
     ::unlink(tmp.c_str());
     return false;
   };
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
+  // A fresh file, never whatever is at <path>.tmp (a FIFO there would block the open).
+  if (::unlink(tmp.c_str()) != 0 && errno != ENOENT) return fail("cannot remove " + tmp, -1);
+  const int fd =
+      ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0640);
   if (fd < 0) return fail("cannot create " + tmp, -1);
   std::size_t done = 0;
   while (done < text.size()) {

@@ -1,10 +1,21 @@
 #include "usv_fdi/dds_service/service.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <mutex>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -62,6 +73,78 @@ class FdiService::Listener : public DataReaderListener {
   std::uint32_t mmsi_;
 };
 
+/// Watches the FaultEvent topic for this vessel's instances written by anyone but this
+/// sidecar: a second sidecar with the same MMSI (every event would reach the monitors twice)
+/// or a forger. Says so loudly: an error line per new writer, then a count every 10 s while
+/// it goes on; the status carries a flag and the count.
+class FdiService::EventWatch : public DataReaderListener {
+ public:
+  EventWatch(std::uint32_t mmsi, eprosima::fastdds::dds::InstanceHandle_t own,
+             FdiService::LogSink log)
+      : mmsi_(mmsi), own_(own), log_(std::move(log)) {}
+  void on_data_available(DataReader* reader) override {
+    fdi::FaultEvent e;
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || e.mmsi() != mmsi_ || info.publication_handle == own_) continue;
+      std::ostringstream guid;
+      guid << info.publication_handle;
+      const auto now = std::chrono::steady_clock::now();
+      std::string line;
+      {
+        std::lock_guard<std::mutex> lock(m_);
+        ++samples_;
+        last_seen_ = now;
+        seen_any_ = true;
+        if (writers_.insert(guid.str()).second) {
+          line = "ANOTHER WRITER publishes FaultEvents of this vessel (MMSI " +
+                 std::to_string(mmsi_) + "): writer " + guid.str() + " wrote " +
+                 sensor_name(e.sensor()) + " #" + std::to_string(e.sequence()) + " (incarnation " +
+                 std::to_string(e.incarnation()) +
+                 "): a second sidecar for this MMSI, or a forger; monitors cannot tell its "
+                 "events from this sidecar's (" +
+                 std::to_string(writers_.size()) + " other writer(s) so far)";
+          last_logged_ = now;
+          logged_samples_ = samples_;
+        } else if (now - last_logged_ >= std::chrono::seconds(10)) {
+          line = "ANOTHER WRITER still publishes FaultEvents of MMSI " + std::to_string(mmsi_) +
+                 ": " + std::to_string(samples_ - logged_samples_) + " more sample(s) from " +
+                 std::to_string(writers_.size()) + " other writer(s)";
+          last_logged_ = now;
+          logged_samples_ = samples_;
+        }
+      }
+      if (!line.empty() && log_) log_(3, line);
+    }
+  }
+  std::uint64_t writers() const {
+    std::lock_guard<std::mutex> lock(m_);
+    return writers_.size();
+  }
+  std::uint64_t samples() const {
+    std::lock_guard<std::mutex> lock(m_);
+    return samples_;
+  }
+  /// True while another writer has written within `window`.
+  bool recent(std::chrono::steady_clock::duration window) const {
+    std::lock_guard<std::mutex> lock(m_);
+    return seen_any_ && std::chrono::steady_clock::now() - last_seen_ <= window;
+  }
+
+ private:
+  static std::string sensor_name(std::uint8_t s) {
+    return s <= 2 ? to_string(static_cast<Sensor>(s)) : "sensor " + std::to_string(s);
+  }
+  std::uint32_t mmsi_;
+  eprosima::fastdds::dds::InstanceHandle_t own_;
+  FdiService::LogSink log_;
+  mutable std::mutex m_;
+  std::set<std::string> writers_;
+  std::uint64_t samples_ = 0, logged_samples_ = 0;
+  bool seen_any_ = false;
+  std::chrono::steady_clock::time_point last_seen_{}, last_logged_{};
+};
+
 FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(std::move(log)) {
   if (cfg_.mmsi == 0) throw std::invalid_argument("service.mmsi must be set (a vessel's MMSI > 0)");
   dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
@@ -96,9 +179,28 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     }
   };
   auto on_status = [this, mmsi, iso](const PipelineStatus& s) {
-    dds::write(*status_writer_, to_dds(s, mmsi, iso));
+    fdi::FdiStatus d = to_dds(s, mmsi, iso);
+    if (watch_) {
+      if (watch_->recent(std::chrono::seconds(10))) {
+        d.input_flags(d.input_flags() | kInputOtherEventWriter);
+      }
+      d.other_event_writers(watch_->writers());
+    }
+    dds::write(*status_writer_, d);
   };
-  pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, cfg_.pipeline, on_event, on_status, log_);
+  // This run's incarnation: its start time (microseconds since the Unix epoch), above that
+  // of every restored event even if the clock went back.
+  PipelineOptions popt = cfg_.pipeline;
+  if (popt.incarnation == 0) {
+    std::uint64_t floor = 0;
+    for (const FaultEvent& e : restored_) floor = std::max(floor, e.incarnation);
+    const auto now_us =
+        static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count());
+    popt.incarnation = std::max(now_us, floor + 1);
+  }
+  pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, popt, on_event, on_status, log_);
   for (const FaultEvent& e : restored_) pipeline_->restore(e);
   listener_ = std::make_unique<Listener>(pipeline_.get(), mmsi);
   DataReader& ins = dds_->create_reader(dds::TopicId::kIns,
@@ -107,13 +209,69 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   DataReader& rudder = dds_->create_reader(
       dds::TopicId::kRudder, cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
                                                   : dds::profiles::kRudderReaderBestEffort);
-  DataReader& ack = dds_->create_reader(dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
+  // Acks are read by a participant of their own: its traffic arrives on its own port, handled
+  // by its own receive thread, so a flood of acks cannot hold up (nor, through KEEP_LAST
+  // histories, lose) the INS and rudder samples behind it.
+  ack_dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
+  DataReader& ack =
+      ack_dds_->create_reader(dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
   listener_->ins_ = &ins;
   listener_->rudder_ = &rudder;
   listener_->ack_ = &ack;
+  watch_ = std::make_unique<EventWatch>(mmsi, event_writer_->get_instance_handle(), log_);
+  event_watch_ = &dds_->create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
 }
 
-FdiService::~FdiService() { stop(); }
+FdiService::~FdiService() {
+  stop();
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the flock
+}
+
+bool FdiService::lock_state(const std::string& dir) {
+  const std::string path =
+      (std::filesystem::path(dir) / ("usv-fdi-" + std::to_string(cfg_.mmsi) + ".lock")).string();
+  const auto say = [this](int level, const std::string& msg) {
+    if (log_) log_(level, "state: " + msg);
+  };
+  const int fd =
+      ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY, 0640);
+  struct stat sb {};
+  if (fd < 0 || ::fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+    // Not a reason to refuse to start; the journal will say whether it can write.
+    say(2, "cannot use the lock file " + path + " (" +
+               (fd < 0 ? std::string(std::strerror(errno))
+                       : "it is " + StateJournal::file_type(sb.st_mode)) +
+               "): a second sidecar on this state directory would not be noticed");
+    if (fd >= 0) ::close(fd);
+    return false;
+  }
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char pid[32] = {0};
+    const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
+    ::close(fd);
+    std::string holder = n > 0 ? std::string(pid, static_cast<std::size_t>(n)) : "";
+    while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
+    if (err == EWOULDBLOCK) {
+      throw StateInUse("the state directory " + dir + " is in use by another sidecar for MMSI " +
+                       std::to_string(cfg_.mmsi) +
+                       (holder.empty() ? std::string() : " (pid " + holder + ")") + ", lock " +
+                       path +
+                       ": two sidecars for one vessel would both publish its events and race "
+                       "on its state file; stop the other one, or give this one its own "
+                       "--state-dir");
+    }
+    say(2, "cannot lock " + path + ": " + std::strerror(err) +
+               ": a second sidecar on this state directory would not be noticed");
+    return false;
+  }
+  const std::string me = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, me.data(), me.size(), 0) < 0) {
+    say(2, "cannot write the pid to " + path + ": " + std::strerror(errno));
+  }
+  lock_fd_ = fd;
+  return true;
+}
 
 namespace {
 
@@ -154,6 +312,7 @@ void FdiService::open_journal() {
     }
     say(1, "created the state directory " + dir);
   }
+  lock_state(dir);  // throws StateInUse if another sidecar has it
   const std::string path = StateJournal::path_for(dir, cfg_.mmsi);
   journal_ = std::make_unique<StateJournal>(path, cfg_.mmsi);
   fs::remove(path + ".tmp", ec);  // a save interrupted by a crash; the file itself is whole
@@ -215,14 +374,27 @@ FdiService::Matches FdiService::matches() const {
     m.rudder_writers = sub.current_count;
   if (listener_->ack_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.ack_writers = sub.current_count;
-  if (event_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
-    m.event_readers = pub.current_count;
+  // Subscribers other than sidecars: not this sidecar's own EventWatch reader (same
+  // participant, matched at once), nor those of the other sidecars on the domain. Fast DDS 2.9
+  // cannot list matched readers, so the other sidecars are counted as the FaultEvent writers
+  // the EventWatch reader has matched besides this sidecar's own (each sidecar has one writer
+  // and one watch reader).
+  if (event_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK) {
+    int others = 0;
+    if (event_watch_ != nullptr &&
+        event_watch_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK) {
+      others = std::max(0, sub.current_count - 1);
+    }
+    m.event_readers = std::max(0, pub.current_count - (event_watch_ != nullptr ? 1 : 0) - others);
+  }
   if (status_writer_->get_publication_matched_status(pub) == ReturnCode_t::RETCODE_OK)
     m.status_readers = pub.current_count;
   return m;
 }
 
 std::uint64_t FdiService::foreign_samples() const { return listener_->foreign.load(); }
+std::uint64_t FdiService::other_event_writers() const { return watch_ ? watch_->writers() : 0; }
+std::uint64_t FdiService::other_event_samples() const { return watch_ ? watch_->samples() : 0; }
 
 void FdiService::start() {
   pipeline_->start();
@@ -230,16 +402,18 @@ void FdiService::start() {
   for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_}) {
     r->set_listener(listener_.get(), StatusMask::data_available());
   }
+  event_watch_->set_listener(watch_.get(), StatusMask::data_available());
 }
 
 void FdiService::stop() {
   if (stopped_) return;
   stopped_ = true;
-  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_}) {
+  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_, event_watch_}) {
     if (r != nullptr) r->set_listener(nullptr);
   }
   pipeline_->stop();  // drains the queues; the publisher thread writes the last events
-  dds_.reset();       // delete_contained_entities(), then the participant
+  ack_dds_.reset();
+  dds_.reset();  // delete_contained_entities(), then the participant
 }
 
 }  // namespace usvfdi::service

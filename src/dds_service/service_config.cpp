@@ -114,6 +114,8 @@ ServiceConfig load_service_config(const std::string& path) {
         cfg.dds.subscriber_partitions = cfg.dds.publisher_partitions;
       } else if (key == "reliable_inputs") {
         cfg.reliable_inputs = get<bool>(path, v, key, "true or false");
+      } else if (key == "lockstep") {
+        cfg.pipeline.lockstep = get<bool>(path, v, key, "true or false");
       } else if (key == "status_rate") {
         const double r = get<double>(path, v, key, "a rate in Hz");
         if (!(r > 0) || !std::isfinite(r)) fail(path, v, key, "must be a positive rate in Hz");

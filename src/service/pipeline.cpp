@@ -94,6 +94,12 @@ std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
 
 int index_of(Sensor s) { return static_cast<int>(s); }
 
+/// Acks handled in one go when no sensor sample is waiting (then the input queue is looked
+/// at again).
+constexpr int kAckBatch = 16;
+/// Refused acks logged in full per ack_log_period before the rest are only summarised.
+constexpr int kAckLogBurst = 5;
+
 bool sensor_level(FaultKind k) {
   return k == FaultKind::kStale || k == FaultKind::kStuck || k == FaultKind::kInvalid;
 }
@@ -109,7 +115,9 @@ std::string input_flag_names(std::uint32_t flags) {
                            {kInputInvalidValues, "invalid_values"},
                            {kInputGaps, "gaps"},
                            {kInputReordered, "reordered"},
-                           {kInputQueueDrops, "queue_drops"}});
+                           {kInputQueueDrops, "queue_drops"},
+                           {kInputSamplesLost, "samples_lost"},
+                           {kInputOtherEventWriter, "other_event_writer"}});
 }
 
 std::string pause_reason_names(std::uint32_t reasons) {
@@ -124,6 +132,30 @@ std::string pause_reason_names(std::uint32_t reasons) {
 
 // ---------------------------------------------------------------- FdiPipeline
 
+void FdiPipeline::SeqGaps::see(std::uint64_t seq) {
+  if (seq == 0) return;
+  std::uint64_t high = highest_.load(std::memory_order_relaxed);
+  for (;;) {
+    if (high != 0 && seq <= high) {
+      if (high - seq >= kRestartWindow) {
+        // The source started counting again (a restart): follow it, nothing was lost.
+        if (!highest_.compare_exchange_weak(high, seq, std::memory_order_relaxed)) continue;
+        restarts_.fetch_add(1, std::memory_order_relaxed);
+        return;
+      }
+      // A late sample of a gap counted already (DDS does not deliver duplicates).
+      std::uint64_t lost = lost_.load(std::memory_order_relaxed);
+      while (lost > 0 && !lost_.compare_exchange_weak(lost, lost - 1, std::memory_order_relaxed)) {
+      }
+      return;
+    }
+    if (highest_.compare_exchange_weak(high, seq, std::memory_order_relaxed)) {
+      if (high != 0) lost_.fetch_add(seq - high - 1, std::memory_order_relaxed);
+      return;
+    }
+  }
+}
+
 FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, EventSink on_event,
                          StatusSink on_status, LogSink on_log)
     : cfg_((cfg.validate(), cfg)),
@@ -132,12 +164,15 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       on_status_(std::move(on_status)),
       on_log_(std::move(on_log)),
       input_(opt.input_capacity),
+      acks_(opt.ack_capacity),
       ident_q_(opt.ident_capacity),
       output_(opt.output_capacity),
       iso_(cfg.isolation, cfg.B),
       assembler_(opt.rudder_wait, opt.rudder_timeout),
       ident_(cfg.identification, cfg.B),
-      gate_(cfg.identification_delay) {}
+      gate_(cfg.identification_delay) {
+  incarnation_ = opt.incarnation;
+}
 
 FdiPipeline::~FdiPipeline() { stop(); }
 
@@ -147,6 +182,7 @@ void FdiPipeline::restore(const FaultEvent& ev) {
   if (i < 0 || i > 2) throw std::invalid_argument("FdiPipeline::restore(): unknown sensor");
   latches_[i].restore(ev);
   restored_.push_back(ev);
+  current_incarnation_[i] = ev.incarnation;
   {
     std::lock_guard<std::mutex> lock(latest_m_);
     latest_[i] = ev;
@@ -173,6 +209,7 @@ void FdiPipeline::stop() {
   if (!started_ || stopped_) return;
   stopped_ = true;
   input_.shutdown();
+  acks_.shutdown();
   if (iso_thread_.joinable()) iso_thread_.join();
   ident_q_.shutdown();
   if (ident_thread_.joinable()) ident_thread_.join();
@@ -189,7 +226,10 @@ void FdiPipeline::log(int level, const std::string& msg) const {
   if (on_log_) on_log_(level, msg);
 }
 
-void FdiPipeline::emit(const FaultEvent& ev) {
+void FdiPipeline::emit(const FaultEvent& ev_in, bool restored) {
+  FaultEvent ev = ev_in;
+  if (!restored && incarnation_ != 0) ev.incarnation = incarnation_;
+  current_incarnation_[index_of(ev.sensor)] = ev.incarnation;
   {
     std::lock_guard<std::mutex> lock(latest_m_);
     latest_[index_of(ev.sensor)] = ev;
@@ -360,31 +400,100 @@ void FdiPipeline::recheck_restored(const Sample& s) {
 
 void FdiPipeline::handle_ack(const AckInput& a) {
   FaultEvent ev;
+  const std::string what =
+      std::string("ack of ") +
+      (static_cast<int>(a.sensor) > 2 ? "sensor " + std::to_string(static_cast<int>(a.sensor))
+                                      : std::string(to_string(a.sensor))) +
+      " #" + std::to_string(a.sequence) + " by " + a.who;
   if (!opt_.authorised_operators.empty() &&
       std::find(opt_.authorised_operators.begin(), opt_.authorised_operators.end(), a.who) ==
           opt_.authorised_operators.end()) {
-    log(2, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
-               " refused: operator '" + a.who + "' is not authorised");
+    refuse_ack(a, "not authorised", what + " refused: operator '" + a.who + "' is not authorised");
     return;
   }
   if (static_cast<int>(a.sensor) > 2) {
-    log(2, "ack refused: unknown sensor " + std::to_string(static_cast<int>(a.sensor)));
+    refuse_ack(a, "unknown sensor", what + " refused: unknown sensor");
     return;
   }
   FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
   const std::uint64_t current = latch.current().sequence;
+  const std::uint64_t inc = current_incarnation_[static_cast<int>(a.sensor)];
+  if (incarnation_ != 0 && a.incarnation != inc) {
+    // Sequences start again in a new run without a state directory: an ack of another run's
+    // event must not acknowledge this run's event of the same number.
+    refuse_ack(a, "other incarnation",
+               what + " refused: incarnation " + std::to_string(a.incarnation) +
+                   " is not that of the current event (#" + std::to_string(current) +
+                   ", incarnation " + std::to_string(inc) + "): it acknowledges an event of " +
+                   (a.incarnation < inc ? "an earlier" : "another") + " run of the sidecar");
+    return;
+  }
   // Stamp: the time of the last sample (before any sample after a restart: the event's own).
   const double t = std::isfinite(last_t_) ? last_t_ : latch.current().t;
   const AckResult r = latch.acknowledge(a.sequence, t, a.who, &ev);
   if (r == AckResult::kAccepted) {
+    ++acks_accepted_;
     log(1, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
                " by " + a.who + " accepted");
     emit(ev);
   } else {
-    log(2, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
-               " by " + a.who + " refused: " + to_string(r) + " (current #" +
-               std::to_string(current) + ", state " + to_string(latch.state()) + ")");
+    refuse_ack(a, to_string(r),
+               what + " refused: " + to_string(r) + " (current #" + std::to_string(current) +
+                   ", state " + to_string(latch.state()) + ")");
   }
+}
+
+void FdiPipeline::refuse_ack(const AckInput&, const std::string& reason,
+                             const std::string& detail) {
+  ++acks_refused_;
+  AckRefusals& r = refusals_;
+  ++r.total;
+  if (r.logged_in_period < kAckLogBurst) {
+    // The first few refusals of a period are logged at once, in full: an operator who
+    // mistyped a sequence sees why.
+    ++r.logged_in_period;
+    log(2, detail);
+    return;
+  }
+  ++r.unlogged;
+  auto it = std::find_if(r.by_reason.begin(), r.by_reason.end(),
+                         [&](const auto& x) { return x.first == reason; });
+  if (it == r.by_reason.end()) {
+    r.by_reason.emplace_back(reason, 1);
+  } else {
+    ++it->second;
+  }
+  r.example = detail;
+}
+
+void FdiPipeline::log_ack_summary(bool force) {
+  AckRefusals& r = refusals_;
+  const auto now = std::chrono::steady_clock::now();
+  const double age = std::chrono::duration<double>(now - r.period_start).count();
+  if (!force && age < opt_.ack_log_period) return;
+  const std::uint64_t dropped = acks_.dropped();
+  if (r.unlogged > 0 || dropped > r.dropped_logged) {
+    std::string reasons;
+    for (const auto& [why, n] : r.by_reason) {
+      reasons += (reasons.empty() ? "" : ", ") + std::to_string(n) + " " + why;
+    }
+    std::string msg = "acks: " + std::to_string(r.unlogged) + " more ack(s) refused in the last " +
+                      fmt("%.1f s", age) + " (" + std::to_string(r.total) + " since start" +
+                      (reasons.empty() ? std::string() : "; " + reasons) + ")";
+    if (dropped > r.dropped_logged) {
+      msg += "; " + std::to_string(dropped - r.dropped_logged) +
+             " dropped unread: the ack queue (" + std::to_string(acks_.capacity()) +
+             ") was full (" + std::to_string(dropped) + " since start)";
+    }
+    if (!r.example.empty()) msg += "; e.g. " + r.example;
+    log(2, msg);
+  }
+  r.dropped_logged = dropped;
+  r.unlogged = 0;
+  r.by_reason.clear();
+  r.example.clear();
+  r.logged_in_period = 0;
+  r.period_start = now;
 }
 
 PipelineStatus FdiPipeline::make_status() {
@@ -407,6 +516,8 @@ PipelineStatus FdiPipeline::make_status() {
   st.invalid_values = in.invalid_values + problems_.invalid;
   st.gaps = in.gaps;
   st.reordered = problems_.reordered;
+  st.lost_ins = ins_seq_.lost();
+  st.lost_rudder = rudder_seq_.lost();
   std::uint32_t f = 0;
   if (st.ins_silent) f |= kInputInsSilent;
   if (!in.delta_ok) f |= kInputRudderMissing;
@@ -417,6 +528,7 @@ PipelineStatus FdiPipeline::make_status() {
   if (st.gaps > logged_.gaps) f |= kInputGaps;
   if (st.reordered > logged_.reordered) f |= kInputReordered;
   if (st.dropped_inputs > logged_.dropped_inputs) f |= kInputQueueDrops;
+  if (st.lost_ins + st.lost_rudder > logged_.lost) f |= kInputSamplesLost;
   st.input_flags = f;
   // Why identification and isolation do not run.
   std::uint32_t id = 0, iso = 0;
@@ -438,6 +550,10 @@ PipelineStatus FdiPipeline::make_status() {
   if (!st.isolation.observer_problem.empty()) iso |= kPauseObserver;
   st.identification_paused = id;
   st.isolation_paused = iso;
+  st.acks_accepted = acks_accepted_.load();
+  st.acks_refused = acks_refused_.load();
+  st.acks_dropped = acks_.dropped();
+  st.incarnation = incarnation_;
   return st;
 }
 
@@ -481,6 +597,19 @@ void FdiPipeline::log_input_changes(const PipelineStatus& st) {
                " sample(s) dropped, oldest first (" + std::to_string(st.dropped_inputs) +
                " since start): samples arrive faster than the isolation thread processes them");
   }
+  const std::uint64_t lost = st.lost_ins + st.lost_rudder;
+  if (lost > logged_.lost) {
+    log(2, "inputs: " + more(lost, logged_.lost) +
+               " sample(s) lost before reaching the sidecar (gaps in the sources' seq; " +
+               std::to_string(st.lost_ins) + " INS and " + std::to_string(st.lost_rudder) +
+               " rudder since start)");
+  }
+  const std::uint64_t restarts = ins_seq_.restarts() + rudder_seq_.restarts();
+  if (restarts > logged_.seq_restarts) {
+    log(1,
+        "inputs: an INS or rudder source started numbering its samples again (seq far "
+        "below the highest seen): taken as a restart of the source, not as a loss");
+  }
   if (st.ins_silent && !had_ins_ && !never_ins_logged_) {
     never_ins_logged_ = true;
     log(2,
@@ -492,6 +621,8 @@ void FdiPipeline::log_input_changes(const PipelineStatus& st) {
   logged_.gaps = st.gaps;
   logged_.reordered = st.reordered;
   logged_.dropped_inputs = st.dropped_inputs;
+  logged_.lost = lost;
+  logged_.seq_restarts = restarts;
 }
 
 PipelineStatus FdiPipeline::status() const {
@@ -504,6 +635,9 @@ PipelineStatus FdiPipeline::status() const {
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
   st.dropped_output = output_.dropped() + dropped_at_stop_.load();
+  st.acks_accepted = acks_accepted_.load();
+  st.acks_refused = acks_refused_.load();
+  st.acks_dropped = acks_.dropped();
   return st;
 }
 
@@ -526,16 +660,28 @@ PipelineLiveness FdiPipeline::liveness() const {
 
 void FdiPipeline::isolation_loop() {
   using Clock = std::chrono::steady_clock;
-  for (const FaultEvent& ev : restored_) emit(ev);
+  for (const FaultEvent& ev : restored_) emit(ev, true);
   auto last_status = Clock::now();
   auto last_ins = Clock::now();
+  refusals_.period_start = last_status;
   std::vector<Sample> batch;
   const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
   for (;;) {
     beat_iso_.store(now_ns(), std::memory_order_relaxed);
     Input in;
-    const auto r = input_.pop_for(&in, std::chrono::milliseconds(50));
+    // Acks waiting: look for a sensor sample without waiting, and take the acks only when
+    // there is none (acks never go ahead of, nor delay, the sensor samples).
+    const bool acks_waiting = acks_.size() > 0;
+    const auto r = input_.pop_for(&in, std::chrono::milliseconds(acks_waiting ? 0 : 50));
     if (r == BoundedQueue<Input>::PopResult::kShutdown) break;
+    if (r == BoundedQueue<Input>::PopResult::kTimeout && acks_waiting) {
+      AckInput a;
+      for (int k = 0; k < kAckBatch && acks_.pop_for(&a, std::chrono::milliseconds(0)) ==
+                                           BoundedQueue<AckInput>::PopResult::kValue;
+           ++k) {
+        handle_ack(a);
+      }
+    }
     const auto now = Clock::now();
     if (r == BoundedQueue<Input>::PopResult::kValue) {
       if (const auto* ins = std::get_if<InsInput>(&in)) {
@@ -543,10 +689,8 @@ void FdiPipeline::isolation_loop() {
         last_ins = now;
         had_ins_ = true;
         if (ins_silent_.exchange(false)) log(1, "INS samples arrive again");
-      } else if (const auto* rud = std::get_if<RudderInput>(&in)) {
-        accept_rudder(*rud);
       } else {
-        handle_ack(std::get<AckInput>(in));
+        accept_rudder(std::get<RudderInput>(in));
       }
       batch.clear();
       assembler_.drain(&batch);
@@ -567,6 +711,7 @@ void FdiPipeline::isolation_loop() {
       last_status = now;
       const PipelineStatus st = make_status();
       log_input_changes(st);
+      log_ack_summary(false);
       {
         std::lock_guard<std::mutex> lock(snap_m_);
         last_status_ = st;
@@ -577,6 +722,7 @@ void FdiPipeline::isolation_loop() {
   batch.clear();
   assembler_.drain(&batch, true);
   for (const Sample& s : batch) process(s);
+  log_ack_summary(true);
   const PipelineStatus st = make_status();
   std::lock_guard<std::mutex> lock(snap_m_);
   last_status_ = st;

@@ -26,12 +26,20 @@
 //                                           PACE_MS wall-clock ms apart (0: as fast as possible)
 //       insonly T0 T1 DT PACE_MS            the same, INS only (a silent rudder)
 //       sleep MS
+//       skip N                              N INS and N rudder sample numbers (seq) left out,
+//                                           as if lost on the way
 //
 //   usv_fdi_dds_probe slow-reader --profiles FILE [DDS options] [--delay-ms D]
 //     The slowest subscriber there is: FaultEvent and FdiStatus readers RELIABLE,
 //     TRANSIENT_LOCAL, KEEP_ALL with room for 2 samples per instance, whose listener sleeps D ms
 //     (default 200) in Fast DDS's receive thread after every sample it takes. Prints "event mmsi=..
 //     sensor=.. sequence=.. state=.." per FaultEvent taken; runs until SIGTERM.
+//
+//   usv_fdi_dds_probe flood-acks --profiles FILE [DDS options] --mmsi M [--timeout SECONDS]
+//     An acknowledgement flood: waits for an ack reader, then writes FaultAcks for vessel M as
+//     fast as the RELIABLE writer takes them, all of them to be refused (unknown sequences
+//     from 1000000 up, an unknown sensor 7, sequence 0), until SIGTERM/SIGINT or the timeout.
+//     Prints "flooding" once matched, then "flooded acks=N" and exits 0.
 //
 //   usv_fdi_dds_probe writer-qos --profiles FILE --writer-profile NAME
 //     Joins the domain as the service does (FASTRTPS_DEFAULT_PROFILES_FILE first, then FILE)
@@ -120,7 +128,7 @@ Options parse(int argc, char** argv) {
   Options o;
   o.mode = argv[1];
   if (o.mode != "publish-faults" && o.mode != "read-faults" && o.mode != "writer-qos" &&
-      o.mode != "publish-inputs" && o.mode != "slow-reader") {
+      o.mode != "publish-inputs" && o.mode != "slow-reader" && o.mode != "flood-acks") {
     throw UsageError("unknown mode '" + o.mode + "'");
   }
   for (int i = 2; i < argc; ++i) {
@@ -366,6 +374,9 @@ int publish_inputs(const Options& o) {
                   0.002 * std::cos(0.3 * t) + 0.0002 * std::cos(11 * t), true, true);
         if (pace > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(pace));
       }
+    } else if (w[0] == "skip") {
+      n_ins += static_cast<std::uint64_t>(arg(1));
+      n_rudder += static_cast<std::uint64_t>(arg(1));
     } else if (w[0] == "sleep") {
       std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(arg(1)));
     } else {
@@ -443,6 +454,40 @@ int slow_reader(const Options& o) {
   return 0;
 }
 
+int flood_acks(const Options& o) {
+  if (o.mmsi == 0) throw UsageError("--mmsi is required");
+  install_signal_handlers();
+  const auto deadline = deadline_after(o.timeout_s);
+  DdsContext ctx(o.dds);
+  fdds::DataWriter& w = ctx.create_writer<fdi::FaultAck>(profiles::kFaultAckWriter);
+  for (;;) {
+    fdds::PublicationMatchedStatus m;
+    w.get_publication_matched_status(m);
+    if (m.current_count > 0) break;
+    if (Clock::now() >= deadline || g_stop.load()) {
+      std::fprintf(stderr, "flood-acks: no ack reader matched\n");
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::printf("flooding\n");
+  std::fflush(stdout);
+  std::uint64_t n = 0;
+  fdi::FaultAck a;
+  a.mmsi(o.mmsi);
+  a.operator_id("flood");
+  while (!g_stop.load() && Clock::now() < deadline) {
+    const std::uint64_t k = n++;
+    a.sensor(static_cast<std::uint8_t>(k % 5 == 4 ? 7 : k % 2));  // 7: no such sensor
+    a.sequence(k % 7 == 6 ? 0 : 1000000 + k);                     // never a current one
+    a.stamp(static_cast<double>(k));
+    (void)w.write(&a);  // RELIABLE: blocks (at most max_blocking_time) when the reader lags
+  }
+  std::printf("flooded acks=%llu\n", static_cast<unsigned long long>(n));
+  std::fflush(stdout);
+  return 0;
+}
+
 int writer_qos(const Options& o) {
   if (o.writer_profile.empty()) throw UsageError("--writer-profile is required");
   DdsContext ctx(o.dds);  // loads the profiles exactly as the service does
@@ -476,6 +521,7 @@ int main(int argc, char** argv) {
     if (o.mode == "writer-qos") return writer_qos(o);
     if (o.mode == "publish-inputs") return publish_inputs(o);
     if (o.mode == "slow-reader") return slow_reader(o);
+    if (o.mode == "flood-acks") return flood_acks(o);
     return o.mode == "publish-faults" ? publish_faults(o) : read_faults(o);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "usv_fdi_dds_probe: %s\n", e.what());

@@ -10,11 +10,16 @@
 //   - bad input over DDS: each kind logged, counted and flagged in FdiStatus, no crash;
 //   - configuration mistakes: exit 2 (or 64) naming file, key and value.
 // Every wait is bounded by a deadline on a condition; no sleep is an assertion.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -103,7 +108,10 @@ TEST_P(RestartWithoutLoss, LatchedFaultsKeepTheirSequenceAcksWorkAndSequencesCon
   const int sig = GetParam();
   const unsigned m = sig == SIGKILL ? 257300001 : 257300002;
   const std::string ms = std::to_string(m);
-  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60"});
+  // lockstep: the detector's results depend on the samples alone, not on how the machine
+  // schedules the identification thread (a busy machine otherwise shifts Â updates and may
+  // add a kind refinement, one more sequence)
+  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60", "lockstep: true"});
   const std::string state_file = f.state_dir("svc") + "/usv-fdi-" + ms + ".state.json";
   // GIVEN a sidecar that raised and cleared the gyro fault (#2, cleared, unacknowledged) and
   // raised the accelerometer fault (#1) of the paper's first 70 s
@@ -219,6 +227,29 @@ TEST(StateFile, CorruptFileOrUnusableDirectoryIsReportedAndTheSidecarStillStarts
                                "NOT survive a restart"),
             std::string::npos)
       << f.log("none");
+}
+
+TEST(StateFile, AFifoAtTheStatePathDoesNotHangStartUp) {
+  Fleet f;
+  const unsigned m = 257300011;
+  const std::string cfg = f.write_service_config("svc", m);
+  const std::string state_file =
+      f.state_dir("svc") + "/usv-fdi-" + std::to_string(m) + ".state.json";
+  // GIVEN a FIFO (nobody writing to it) where the state file should be
+  fs::create_directories(f.state_dir("svc"));
+  ASSERT_EQ(::mkfifo(state_file.c_str(), 0600), 0) << std::strerror(errno);
+  // WHEN the sidecar starts THEN it does not wait for a writer: it says what is there, sets
+  // it aside and runs with no latched faults
+  ChildProcess& svc = f.start_service("svc", cfg);
+  const std::string log = f.log("svc");
+  EXPECT_NE(log.find("state: cannot restore latched faults: " + state_file +
+                     ": is a FIFO (named pipe), not a state file (a regular file)"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("starting with no latched faults"), std::string::npos) << log;
+  EXPECT_TRUE(fs::is_regular_file(state_file)) << "a fresh state file is written";
+  ASSERT_TRUE(svc.running());
+  kill_and_reap(svc, SIGTERM, 0);
 }
 
 // ------------------------------------------------------------------ health check
@@ -511,6 +542,249 @@ TEST(BadInput, ABurstLargerThanTheInputQueueDropsTheOldestAndSaysSo) {
   EXPECT_NE(f.log("svc").find("inputs: input queue full (2): "), std::string::npos) << f.log("svc");
   EXPECT_NE(f.log("svc").find("sample(s) dropped, oldest first"), std::string::npos);
   ASSERT_TRUE(svc.running());
+  kill_and_reap(svc, SIGTERM, 0);
+}
+
+// ------------------------------------------------------------------ acknowledgement flood
+
+/// The residual fault of `sensor` on (t0, t1) as the monitor saw it (events before the end
+/// of the data, t < 100 s): raised within 3 s of t0 and isolated to it, cleared after t1.
+void expect_episode(const std::vector<MonitorEvent>& all, const std::string& sensor, double t0,
+                    double t1) {
+  SCOPED_TRACE(sensor);
+  std::vector<MonitorEvent> in;
+  for (const auto& e : all) {
+    if (e.sensor == sensor && e.stamp < 100.0) in.push_back(e);
+  }
+  ASSERT_GE(in.size(), 2u) << "expected raised and cleared";
+  EXPECT_EQ(in.front().state, "raised");
+  EXPECT_GE(in.front().stamp, t0) << "raised before the fault's onset: a false raise";
+  EXPECT_LE(in.front().stamp, t0 + 3.0);
+  EXPECT_GE(sensor == "gyro" ? in.front().c_g : in.front().c_a, 0.8) << "not isolated";
+  EXPECT_EQ(in.back().state, "cleared");
+  EXPECT_GE(in.back().stamp, t1);
+  EXPECT_LE(in.back().stamp, t1 + 5.0);
+  for (std::size_t i = 1; i + 1 < in.size(); ++i) {
+    EXPECT_EQ(in[i].state, "raised") << "only kind refinements between";
+  }
+}
+
+TEST(AckFlood, RefusedAcksAreCountedInBoundedLogAndDetectionIsUnchanged) {
+  Fleet f;
+  const unsigned m = 257300010;
+  const std::string ms = std::to_string(m);
+  // lockstep: the detector's results depend on the samples alone (not on how the busy
+  // machine schedules the identification thread), so "unchanged" means: every sample
+  // arrived, in order, and made the same decisions
+  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60", "lockstep: true"});
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  ChildProcess& svc = f.start_service("svc", cfg, 1);
+  // GIVEN a participant that floods the sidecar with acks it must refuse
+  ChildProcess& flood = f.start_probe("flood", "flood-acks", {"--mmsi", ms, "--timeout", "120"});
+  const auto first = flood.read_line(seconds(20));
+  ASSERT_TRUE(first && *first == "flooding") << f.log("flood");
+  // WHEN the vessel sails the paper's scenario (5x real time) through the flood
+  const auto t0 = Clock::now();
+  ChildProcess& sim = f.start("sim", sim_args({"--mmsi", ms, "--speed", "5"}));
+  const auto sim_code = sim.wait_exit(seconds(90));
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_TRUE(sim_code.has_value() && *sim_code == 0) << f.log("sim");
+  const auto until = Clock::now() + seconds(10);
+  while (Clock::now() < until) {
+    const Key k = logged_latest(f.log("svc"), m);
+    if (k.count("accelerometer") && k.at("accelerometer").second == "cleared") break;
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  flood.signal(SIGTERM);
+  const std::string flooded = flood.read_all(seconds(10));
+  ASSERT_TRUE(flood.wait_exit(seconds(5)).has_value());
+  unsigned long long acks = 0;
+  ASSERT_EQ(std::sscanf(flooded.c_str(), "flooded acks=%llu", &acks), 1) << flooded;
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  read_monitor_until(
+      control, &ev, &st, seconds(3), [](const auto&) { return false; }, &err);
+  const std::string log = f.log("svc");
+  std::printf("ack flood: %llu acks in %.1f s (%.0f/s), sidecar log %zu bytes\n", acks, wall,
+              static_cast<double>(acks) / wall, log.size());
+  // THEN it was a flood (thousands of acks a second)
+  EXPECT_GE(static_cast<double>(acks) / wall, 1000.0) << "not a flood";
+  // AND each fault was raised at its onset on its own sensor and cleared; nothing else
+  expect_episode(ev, "gyro", 20.0, 40.0);
+  expect_episode(ev, "accelerometer", 60.0, 80.0);
+  for (const auto& e : ev) EXPECT_NE(e.sensor, "unknown") << dump(ev);
+  EXPECT_FALSE(ev.empty()) << dump(ev);
+  // AND no sensor sample was lost to the flood, neither in DDS nor in the sidecar's queue
+  ASSERT_FALSE(st.empty());
+  EXPECT_EQ(st.back().dropped_inputs, 0u);
+  EXPECT_GE(st.back().samples, 5000u);
+  for (const auto& s : st) EXPECT_FALSE(s.has_flag("samples_lost"));
+  // AND the refusals are summarised: the log stays small (about a line per second of
+  // flood), where one line per refused ack would be some 100 bytes x acks
+  EXPECT_NE(log.find("more ack(s) refused in the last"), std::string::npos) << log.substr(0, 4000);
+  EXPECT_NE(log.find("unknown sequence"), std::string::npos);
+  EXPECT_LT(log.size(), 100000u + 200u * static_cast<std::size_t>(wall)) << log.substr(0, 4000);
+  // AND its own events were never taken for another writer's
+  EXPECT_EQ(log.find("ANOTHER WRITER"), std::string::npos) << log.substr(0, 4000);
+  ASSERT_TRUE(svc.running());
+  kill_and_reap(svc, SIGTERM, 0);
+}
+
+// ------------------------------------------------------------------ unread stderr
+
+TEST(UnreadStderr, TheSidecarStillPublishesAndStopsOnSigterm) {
+  Fleet f;
+  const unsigned m = 257300012;
+  const std::string ms = std::to_string(m);
+  const std::string cfg =
+      f.write_service_config("svc", m, {"status_rate: 10", "input_timeout: 60"});
+  // GIVEN a sidecar whose stderr is a pipe (of one page) that nobody reads
+  int fds[2];
+  ASSERT_EQ(::pipe2(fds, O_CLOEXEC), 0);
+  (void)::fcntl(fds[1], F_SETPIPE_SZ, 4096);
+  // full from the start: the sidecar's first line to stderr already blocks (its own open of
+  // the pipe blocks; ours here does not)
+  ASSERT_EQ(::fcntl(fds[1], F_SETFL, O_NONBLOCK), 0);
+  const std::string page(4096, 'x');
+  std::size_t filled = 0;
+  for (ssize_t n; (n = ::write(fds[1], page.data(), page.size())) > 0;) {
+    filled += static_cast<std::size_t>(n);
+  }
+  ASSERT_GT(filled, 0u);
+  std::vector<std::string> argv = {USV_FDI_EXE, "run", "--config", cfg};
+  for (const auto& x : f.dds_args()) argv.push_back(x);
+  auto svc = std::make_unique<ChildProcess>(argv, "/proc/self/fd/" + std::to_string(fds[1]));
+  ::close(fds[1]);
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  // AND much to log: refused acks (some lines in full) and a voyage with its events
+  ChildProcess& flood = f.start_probe("flood", "flood-acks", {"--mmsi", ms, "--timeout", "60"});
+  const auto first = flood.read_line(seconds(20));
+  ASSERT_TRUE(first && *first == "flooding") << f.log("flood");
+  ChildProcess& sim = f.start("sim", sim_args({"--mmsi", ms, "--speed", "10", "--duration", "45"}));
+  // WHEN the pipe has long been full THEN the sidecar still processes and publishes: the
+  // status shows the voyage's samples, the gyro fault is raised and cleared
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  const bool went_on = read_monitor_until(
+      control, &ev, &st, seconds(60),
+      [&](const std::vector<MonitorEvent>& e) {
+        bool cleared = false;
+        for (const auto& x : e)
+          cleared |= x.mmsi == m && x.sensor == "gyro" && x.state == "cleared";
+        return cleared && !st.empty() && st.back().samples >= 2000;
+      },
+      &err);
+  EXPECT_TRUE(went_on) << err << dump(ev)
+                       << (st.empty() ? std::string("no status")
+                                      : "samples " + std::to_string(st.back().samples));
+  const auto sim_code = sim.wait_exit(seconds(30));
+  EXPECT_TRUE(sim_code.has_value() && *sim_code == 0) << f.log("sim");
+  flood.signal(SIGTERM);
+  // AND it exits 0 on SIGTERM although its last lines cannot be written
+  const auto t0 = Clock::now();
+  svc->signal(SIGTERM);
+  const auto code = svc->wait_exit(seconds(15));
+  const double took = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_TRUE(code.has_value()) << "SIGTERM ignored: still running 15 s later";
+  EXPECT_EQ(*code, 0);
+  std::printf("with stderr unread: stopped %.3f s after SIGTERM\n", took);
+  ::close(fds[0]);
+}
+
+// ------------------------------------------------------------------ burst loss
+
+TEST(BadInput, SamplesLostOnTheWayAreCountedFromTheSeqGapsAndFlagged) {
+  Fleet f;
+  const unsigned m = 257300013;
+  const std::string ms = std::to_string(m);
+  const std::string cfg =
+      f.write_service_config("svc", m, {"status_rate: 10", "input_timeout: 60"});
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  ChildProcess& svc = f.start_service("svc", cfg, 1);
+  // GIVEN a source whose sample numbers jump twice: 7 and then 5 INS and rudder samples never
+  // reach the sidecar
+  const std::string script = f.dir() + "lost.script";
+  std::ofstream(script) << "both 0 2 0.02 0\nskip 7\nboth 2 4 0.02 0\nskip 5\nboth 4 5 0.02 0\n";
+  ChildProcess& probe = f.start_probe("probe", "publish-inputs",
+                                      {"--mmsi", ms, "--script", script, "--timeout", "20"});
+  const auto pcode = probe.wait_exit(seconds(40));
+  ASSERT_TRUE(pcode.has_value() && *pcode == 0) << f.log("probe");
+  // THEN a status period flags the loss, and the log counts it per stream
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  EXPECT_TRUE(read_monitor_until(
+      control, &ev, &st, seconds(15),
+      [&](const auto&) {
+        return std::any_of(st.begin(), st.end(),
+                           [](const MonitorStatus& s) { return s.has_flag("samples_lost"); });
+      },
+      &err))
+      << err << f.log("svc");
+  ASSERT_TRUE(f.wait_for_log("svc", "12 INS and 12 rudder since start", seconds(10)))
+      << f.log("svc");
+  EXPECT_NE(f.log("svc").find("sample(s) lost before reaching the sidecar"), std::string::npos);
+  // AND the samples that arrived were all processed (nothing dropped by the sidecar itself)
+  ASSERT_FALSE(st.empty());
+  EXPECT_EQ(st.back().dropped_inputs, 0u);
+  kill_and_reap(svc, SIGTERM, 0);
+}
+
+// ------------------------------------------------------------------ two sidecars, one MMSI
+
+TEST(TwoSidecarsOneMmsi, TheSecondOnTheSameStateDirectoryRefusesToStart) {
+  Fleet f;
+  const unsigned m = 257300014;
+  const std::string cfg = f.write_service_config("svc", m);
+  // GIVEN a running sidecar
+  ChildProcess& first = f.start_service("svc", cfg);
+  // WHEN a second one for the same MMSI and state directory starts
+  const auto code = f.run_to_end("second", {"run", "--config", cfg}, seconds(20));
+  // THEN it refuses at once (exit 75), naming the directory, the other pid and the remedy
+  ASSERT_TRUE(code.has_value()) << "the second sidecar runs\n" << f.log("second");
+  EXPECT_EQ(*code, 75) << f.log("second");
+  const std::string log = f.log("second");
+  EXPECT_NE(log.find("refusing to start: the state directory " + f.state_dir("svc") +
+                     " is in use by another sidecar for MMSI " + std::to_string(m) + " (pid " +
+                     std::to_string(first.pid()) + ")"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("--state-dir"), std::string::npos) << log;
+  // AND the first one runs on, undisturbed
+  ASSERT_TRUE(first.running());
+  kill_and_reap(first, SIGTERM, 0);
+  // AND once it has stopped, a sidecar may start on that directory again
+  ChildProcess& again = f.start_service("again", cfg);
+  ASSERT_TRUE(again.running()) << f.log("again");
+  kill_and_reap(again, SIGTERM, 0);
+}
+
+TEST(TwoSidecarsOneMmsi, AnotherWriterOfThisVesselsEventsIsReportedLoudly) {
+  Fleet f;
+  const unsigned m = 257300015;
+  const std::string cfg = f.write_service_config("svc", m, {"status_rate: 10"});
+  ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
+  ChildProcess& svc = f.start_service("svc", cfg, 1);
+  // GIVEN another participant that writes FaultEvents of this vessel (a second sidecar on
+  // another state directory, or a forger)
+  f.start_probe(
+      "other", "publish-faults",
+      {"--vessels", "1", "--sensors", "2", "--mmsi-base", std::to_string(m), "--timeout", "60"});
+  // THEN the sidecar logs an error naming the other writer, and FdiStatus flags it
+  ASSERT_TRUE(f.wait_for_log("svc",
+                             "ANOTHER WRITER publishes FaultEvents of this vessel (MMSI " +
+                                 std::to_string(m) + "): writer ",
+                             seconds(20)))
+      << f.log("svc");
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  EXPECT_TRUE(read_monitor_until(
+      control, &ev, &st, seconds(15),
+      [&](const auto&) { return !st.empty() && st.back().has_flag("other_event_writer"); }, &err))
+      << err << f.log("svc");
   kill_and_reap(svc, SIGTERM, 0);
 }
 

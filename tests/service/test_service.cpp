@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "../dds/starvation.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
@@ -129,12 +130,14 @@ class Peer {
     dds::write(*ins_, s);
   }
 
-  void ack(std::uint32_t mmsi, Sensor sensor, std::uint64_t seq, const std::string& who) {
+  void ack(std::uint32_t mmsi, Sensor sensor, std::uint64_t seq, const std::string& who,
+           std::uint64_t incarnation) {
     fdi::FaultAck a;
     a.mmsi(mmsi);
     a.sensor(static_cast<std::uint8_t>(sensor));
     a.sequence(seq);
     a.operator_id(who.c_str());
+    a.incarnation(incarnation);
     dds::write(*ack_, a);
   }
 
@@ -222,10 +225,12 @@ TEST(ServiceInProcess, PaperScenarioOverDdsRaisesIsolatesAndClearsThenAcks) {
   EXPECT_EQ(svc.foreign_samples(), 2u * 2u);  // INS + rudder of vessel M+1, twice
 
   // WHEN a stale ack, an unknown ack and then the right one arrive
-  peer.ack(m, Sensor::kGyro, 1, "op");
-  peer.ack(m, Sensor::kGyro, 5, "op");
-  peer.ack(m + 1, Sensor::kGyro, 2, "op");  // another vessel's: not this sidecar's business
-  peer.ack(m, Sensor::kGyro, 2, "op");
+  const std::uint64_t inc = cleared.incarnation();
+  EXPECT_EQ(inc, svc.incarnation());
+  peer.ack(m, Sensor::kGyro, 1, "op", inc);
+  peer.ack(m, Sensor::kGyro, 5, "op", inc);
+  peer.ack(m + 1, Sensor::kGyro, 2, "op", inc);  // another vessel's: not this sidecar's business
+  peer.ack(m, Sensor::kGyro, 2, "op", inc);
   // THEN only the last one moves the latch (cleared-unacknowledged -> acknowledged)
   ev.clear();
   ASSERT_TRUE(peer.events_until(&ev, milliseconds(10000), [](const auto& e) {
@@ -249,6 +254,89 @@ TEST(ServiceInProcess, PaperScenarioOverDdsRaisesIsolatesAndClearsThenAcks) {
   svc.stop();
   EXPECT_EQ(svc.status().dropped_inputs, 0u);
   EXPECT_EQ(svc.status().dropped_output, 0u);
+}
+
+TEST(ServiceInProcess, ARestartWithoutStateNeverRepeatsAnEventAndRefusesTheOldRunsAcks) {
+  // GIVEN a sidecar without a state directory that raised and cleared the gyro fault (#1, #2)
+  const std::uint32_t m = 257200003;
+  const ServiceConfig cfg = paper_service(m, partition());
+  ASSERT_TRUE(cfg.state_dir.empty());
+  Logs logs1, logs2;  // outlive the services that log into them
+  const auto voyage = [&](Logs& logs, std::vector<fdi::FaultEvent>* ev,
+                          std::uint64_t* incarnation) {
+    auto svc = std::make_unique<FdiService>(cfg, logs.sink());
+    svc->start();
+    *incarnation = svc->incarnation();
+    Peer peer(cfg);
+    EXPECT_TRUE(peer.wait_matched(milliseconds(15000)));
+    std::uint64_t seq = 0;
+    for (const SimRow& r : paper_rows(45.0)) peer.write(m, ++seq, r.t, r.v, r.r, r.delta);
+    EXPECT_TRUE(peer.events_until(ev, milliseconds(60000), [](const auto& e) {
+      return has_event(e, Sensor::kGyro, FaultState::kClearedUnacknowledged);
+    }));
+    return std::make_pair(std::move(svc), std::make_unique<Peer>(cfg));
+  };
+  std::vector<fdi::FaultEvent> first, second;
+  std::uint64_t inc1 = 0, inc2 = 0;
+  auto run1 = voyage(logs1, &first, &inc1);
+  ASSERT_FALSE(first.empty());
+  run1.first->stop();
+  run1 = {};
+  // WHEN it restarts (no state: its sequences start again at 1) and sails again
+  auto run2 = voyage(logs2, &second, &inc2);
+  ASSERT_FALSE(second.empty());
+  // THEN every event carries its run's incarnation, later runs' higher: no (incarnation,
+  // sequence) of the second run is one of the first
+  EXPECT_GT(inc2, inc1);
+  for (const auto& e : first) EXPECT_EQ(e.incarnation(), inc1);
+  for (const auto& e : second) EXPECT_EQ(e.incarnation(), inc2);
+  const fdi::FaultEvent& now = second.back();
+  EXPECT_EQ(now.sequence(), first.back().sequence()) << "the same number, another event";
+  // AND an ack of the first run's event (same sequence, old incarnation) is refused, the
+  // ack of the current one accepted
+  Peer& peer = *run2.second;
+  ASSERT_TRUE(peer.wait_matched(milliseconds(15000)));
+  peer.ack(m, Sensor::kGyro, now.sequence(), "op", inc1);
+  peer.ack(m, Sensor::kGyro, now.sequence(), "op", 0);  // no incarnation at all
+  std::this_thread::sleep_for(milliseconds(300));
+  std::vector<fdi::FaultEvent> ev;
+  peer.events_until(&ev, milliseconds(500), [](const auto&) { return false; });
+  for (const auto& e : ev) {
+    EXPECT_NE(e.state(), static_cast<std::uint8_t>(FaultState::kAcknowledged))
+        << "acknowledged by an ack of another run";
+  }
+  EXPECT_EQ(run2.first->status().acks_refused, 2u);
+  EXPECT_TRUE(logs2.contains("refused: incarnation " + std::to_string(inc1) +
+                             " is not that of the current event"));
+  peer.ack(m, Sensor::kGyro, now.sequence(), "op", inc2);
+  ASSERT_TRUE(peer.events_until(&ev, milliseconds(10000), [](const auto& e) {
+    return has_event(e, Sensor::kGyro, FaultState::kAcknowledged);
+  }));
+  EXPECT_EQ(ev.back().incarnation(), inc2);
+  EXPECT_EQ(run2.first->status().acks_accepted, 1u);
+  run2.first->stop();
+}
+
+TEST(SeqGaps, GapsAreLostSamplesLateOnesAreTakenOffARestartIsNoLoss) {
+  FdiPipeline::SeqGaps g;
+  g.see(0);  // not numbered: ignored
+  EXPECT_EQ(g.lost(), 0u);
+  // GIVEN a stream that starts at 100 (a late joiner: nothing before counts) with two gaps
+  for (std::uint64_t s = 100; s <= 110; ++s) g.see(s);
+  for (std::uint64_t s = 116; s <= 120; ++s) g.see(s);  // 111..115 missing
+  g.see(125);                                           // 121..124 missing
+  EXPECT_EQ(g.lost(), 9u);
+  // WHEN one of the missing arrives late THEN it is taken off
+  g.see(113);
+  EXPECT_EQ(g.lost(), 8u);
+  EXPECT_EQ(g.restarts(), 0u);
+  // WHEN the source restarts its count THEN that is no loss, and counting goes on from there
+  for (std::uint64_t s = 126; s <= 5000; ++s) g.see(s);
+  g.see(1);
+  g.see(2);
+  g.see(4);
+  EXPECT_EQ(g.restarts(), 1u);
+  EXPECT_EQ(g.lost(), 9u);
 }
 
 TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
@@ -279,6 +367,7 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
   std::this_thread::sleep_for(milliseconds(700));
   // WHEN it stops (listeners detached, queues shut down, threads joined, DDS entities
   // deleted) while the writers keep going
+  usv_fdi::dds::test::StarvationMeter meter;
   const auto t0 = Clock::now();
   svc->stop();
   const double took = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -287,8 +376,9 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
   go = false;
   ta.join();
   tb.join();
-  // THEN it was done well within 2 s and had been working
-  EXPECT_LT(took, 2.0);
+  // THEN it was done within 2 s (plus what the machine's starvation explains) and had been
+  // working
+  EXPECT_LT(took, meter.limit(2.0)) << meter.report();
   EXPECT_GT(st.samples + st.rejected + st.dropped_inputs, 100u);
   std::printf("stop() took %.3f s; %llu samples, %llu rejected, %llu dropped\n", took,
               static_cast<unsigned long long>(st.samples),

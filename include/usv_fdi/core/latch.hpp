@@ -28,6 +28,8 @@ struct FaultEvent {
   std::uint64_t sequence = 0;    ///< per-instance, increases with every event
   Mat2 A = Mat2::Zero();         ///< estimate of A in force
   std::string message;
+  /// The service run that issued `sequence` (set by the sidecar's pipeline; 0 elsewhere).
+  std::uint64_t incarnation = 0;
 };
 
 enum class AckResult : std::uint8_t {

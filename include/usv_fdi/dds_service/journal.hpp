@@ -17,13 +17,17 @@
 //     "mmsi": 257000001,
 //     "written": 1732370000.123,
 //     "instances": [
-//       {"sensor": "gyro", "state": "raised", "kind": "bias", "sequence": 3, "c_a": 0.01,
+//       {"sensor": "gyro", "state": "raised", "kind": "bias", "sequence": 3,
+//        "incarnation": 1764624000123456, "c_a": 0.01,
 //        "c_g": 0.99, "statistic": 14.1, "threshold": 6, "onset_time": 20, "detection_time": 20.4,
 //        "stamp": 20.4, "a": [-0.1, 0.2, 0.3, -0.4], "message": "..."}
 //     ],
 //     "checksum": "fnv1a64:0123456789abcdef"
 //   }
 // Numbers are written with 17 significant digits (exact round trip); NaN as null.
+// "incarnation" (the sidecar run that issued the sequence) may be missing (files written
+// before it existed): 0. A file that is not a regular file (a FIFO, a directory) is refused
+// without blocking.
 #pragma once
 
 #include <array>
@@ -62,13 +66,17 @@ class StateJournal {
 
   enum class LoadResult : std::uint8_t { kLoaded, kMissing, kError };
   /// Reads the file at `path`. kMissing: no such file (a first start). kError: *error names
-  /// the file and what was wrong (unreadable, not JSON, wrong version or MMSI, checksum ...).
+  /// the file and what was wrong (unreadable, not a regular file, not JSON, wrong version or
+  /// MMSI, checksum ...). Never blocks: a FIFO or device at `path` is refused without reading.
   static LoadResult load(const std::string& path, std::uint32_t mmsi, Contents* out,
                          std::string* error);
 
   /// Replaces `path` by `text` atomically and durably: <path>.tmp, fsync, rename, fsync of
   /// the directory. Returns false with *error (path and errno text); `path` is then unchanged.
   static bool write_atomic(const std::string& path, const std::string& text, std::string* error);
+
+  /// "a FIFO (named pipe)", "a directory", ... for a stat mode.
+  static std::string file_type(unsigned mode);
 
   /// Renames a bad state file to <path>.corrupt-<UTC time> so that it is kept for inspection
   /// and not read again. Returns the new name, or "" (with *error) if that failed.

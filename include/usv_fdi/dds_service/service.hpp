@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,7 @@ struct ServiceConfig {
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
 ///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
 ///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
-///   reliable_inputs, status_rate [Hz], log_level, authorised_operators: [..],
+///   reliable_inputs, lockstep, status_rate [Hz], log_level, authorised_operators: [..],
 ///   input_queue, rudder_wait, rudder_timeout, input_timeout, restore_recheck,
 ///   state_dir (relative to the config file; "" : no persistence), health_file.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
@@ -44,10 +45,18 @@ ServiceConfig load_service_config(const std::string& path);
 /// file shipped in the source tree's config/qos/.
 std::string default_qos_profiles();
 
+/// Thrown by FdiService when another process holds the state directory's lock for this
+/// vessel (a second sidecar for the same MMSI on the same state directory).
+class StateInUse : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class FdiService {
  public:
   using LogSink = FdiPipeline::LogSink;
-  /// Creates every DDS entity and the pipeline; throws std::runtime_error naming what failed.
+  /// Creates every DDS entity and the pipeline; throws std::runtime_error naming what failed,
+  /// StateInUse when another sidecar holds <state_dir>/usv-fdi-<mmsi>.lock.
   FdiService(const ServiceConfig& cfg, LogSink log);
   ~FdiService();
   FdiService(const FdiService&) = delete;
@@ -58,6 +67,8 @@ class FdiService {
   /// Idempotent; the destructor calls it.
   void stop();
   PipelineStatus status() const { return pipeline_->status(); }
+  /// This run's incarnation (FaultEvent.incarnation of the events it issues).
+  std::uint64_t incarnation() const { return pipeline_->incarnation(); }
   PipelineLiveness liveness() const { return pipeline_->liveness(); }
 
   /// The state journal's file ("" when state is not persisted) and the error of its last
@@ -81,10 +92,16 @@ class FdiService {
   Matches matches() const;
   /// Samples on the input topics that carried another vessel's MMSI (skipped).
   std::uint64_t foreign_samples() const;
+  /// Distinct other DDS writers seen publishing this vessel's FaultEvents (a second sidecar
+  /// with the same MMSI, or a forger), and the samples they wrote.
+  std::uint64_t other_event_writers() const;
+  std::uint64_t other_event_samples() const;
 
  private:
   class Listener;
+  class EventWatch;
   void open_journal();
+  bool lock_state(const std::string& dir);
   ServiceConfig cfg_;
   LogSink log_;
   std::unique_ptr<StateJournal> journal_;
@@ -92,9 +109,14 @@ class FdiService {
   std::string journal_error_logged_;  ///< publisher thread: the save error already logged
   std::unique_ptr<FdiPipeline> pipeline_;
   std::unique_ptr<Listener> listener_;
+  std::unique_ptr<EventWatch> watch_;
+  int lock_fd_ = -1;  ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
   std::unique_ptr<usv_fdi::dds::DdsContext> dds_;
+  /// The participant of the ack reader alone (its own port and receive thread).
+  std::unique_ptr<usv_fdi::dds::DdsContext> ack_dds_;
   eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
+  eprosima::fastdds::dds::DataReader* event_watch_ = nullptr;  ///< FaultEvent, for EventWatch
   bool stopped_ = false;
 };
 

@@ -3,6 +3,10 @@
 //   latch, acks) -> identification queue -> identification thread (DREM, publishes estimate
 //   snapshots back to the isolation thread) ; isolation thread -> output queue -> publisher
 //   thread (hands events and status to the sink, so a slow writer never blocks isolation).
+// Operator acknowledgements have a bounded queue of their own: the isolation thread takes
+// them only when no sensor sample is waiting, so a flood of acks can neither delay nor
+// re-order sensor processing; refused acks are counted and logged with a rate limit (the
+// first few of an ack_log_period in full, then one summary line with counts and an example).
 // Overflow policy: every queue drops its oldest element when full and counts the drop; the
 // latest state of every fault instance still reaches the sink after an output overflow.
 // Input problems (bad stamps, invalid values, gaps, re-ordering, overflow, silent streams) are
@@ -34,18 +38,21 @@ struct InsInput {
   double r = kNaN;      ///< [rad/s]
   bool v_valid = true;
   bool r_valid = true;
+  std::uint64_t seq = 0;  ///< the source's sample number (InsSample.seq); 0: not numbered
 };
 
 struct RudderInput {
   double stamp = kNaN;  ///< source time [s]
   double delta = kNaN;  ///< [rad]
   bool valid = true;
+  std::uint64_t seq = 0;  ///< the source's sample number (RudderSample.seq); 0: not numbered
 };
 
 struct AckInput {
   Sensor sensor = Sensor::kUnknown;
   std::uint64_t sequence = 0;
   std::string who;
+  std::uint64_t incarnation = 0;  ///< FaultEvent::incarnation of the acknowledged event
 };
 
 /// Pairs INS samples with the rudder angle at the same source time: linear interpolation
@@ -74,7 +81,8 @@ class SampleAssembler {
 };
 
 struct PipelineOptions {
-  std::size_t input_capacity = 4096;   ///< listener -> isolation thread
+  std::size_t input_capacity = 4096;   ///< listener -> isolation thread (INS, rudder)
+  std::size_t ack_capacity = 64;       ///< listener -> isolation thread (acks; oldest dropped)
   std::size_t ident_capacity = 16384;  ///< isolation -> identification thread
   std::size_t output_capacity = 4096;  ///< isolation -> publisher thread
   double rudder_wait = 0.1;            ///< [s, source time]
@@ -94,6 +102,15 @@ struct PipelineOptions {
   bool lockstep = false;
   /// Operators allowed to acknowledge (empty: anyone who can write the ack topic).
   std::vector<std::string> authorised_operators;
+  /// Refused acks are logged in full 5 times per this period (wall clock) [s] at most, the
+  /// others in one summary line at its end (counts by reason, an example).
+  double ack_log_period = 5.0;
+  /// This run's incarnation, carried by every event it issues (FaultEvent::incarnation):
+  /// (incarnation, sequence) never repeats across restarts, and an ack must name the
+  /// incarnation of the event it acknowledges. The sidecar sets its start time, microseconds
+  /// since the Unix epoch (above every restored event's). 0: no incarnations (replay, tests):
+  /// events keep theirs and acks are not checked for one.
+  std::uint64_t incarnation = 0;
 };
 
 /// Input problems (PipelineStatus::input_flags). The values are those of the INPUT_*
@@ -109,6 +126,10 @@ enum InputFlag : std::uint32_t {
   kInputGaps = 1u << 6,           ///< gaps between INS samples longer than stale_timeout
   kInputReordered = 1u << 7,      ///< samples delivered out of order (re-sorted)
   kInputQueueDrops = 1u << 8,     ///< input queue overflow: oldest samples dropped
+  kInputSamplesLost = 1u << 9,    ///< gaps in the sources' seq: samples lost before the sidecar
+  /// Set by the DDS service, not the pipeline: another DDS writer published this vessel's
+  /// FaultEvents within the last 10 s (a second sidecar with the same MMSI, or a forger).
+  kInputOtherEventWriter = 1u << 10,
 };
 
 /// Why identification or isolation is paused (PipelineStatus::identification_paused,
@@ -140,13 +161,21 @@ struct PipelineStatus {
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
   // Input problems, counted since start (see InputFlag for the per-period flags).
-  std::uint32_t input_flags = 0;            ///< InputFlag bits
-  std::uint64_t rejected_timestamps = 0;    ///< repeated/backward (engine) + non-finite stamps
-  std::uint64_t invalid_values = 0;         ///< NaN flagged valid, Inf, absurd magnitudes
-  std::uint64_t gaps = 0;                   ///< gaps longer than stale_timeout
-  std::uint64_t reordered = 0;              ///< INS samples older than one already received
+  std::uint32_t input_flags = 0;          ///< InputFlag bits
+  std::uint64_t rejected_timestamps = 0;  ///< repeated/backward (engine) + non-finite stamps
+  std::uint64_t invalid_values = 0;       ///< NaN flagged valid, Inf, absurd magnitudes
+  std::uint64_t gaps = 0;                 ///< gaps longer than stale_timeout
+  std::uint64_t reordered = 0;            ///< INS samples older than one already received
+  /// Samples lost before they reached the sidecar (in DDS or the source): gaps in the seq of
+  /// InsSample / RudderSample, since start (a late sample of a gap is taken off again).
+  std::uint64_t lost_ins = 0, lost_rudder = 0;
   std::uint32_t identification_paused = 0;  ///< PauseReason bits (0: identifying)
   std::uint32_t isolation_paused = 0;       ///< PauseReason bits (0: detecting)
+  // Operator acknowledgements since start.
+  std::uint64_t acks_accepted = 0;
+  std::uint64_t acks_refused = 0;  ///< unauthorised, unknown sensor, stale or unknown sequence...
+  std::uint64_t acks_dropped = 0;  ///< ack queue overflow (a flood), oldest dropped
+  std::uint64_t incarnation = 0;   ///< this run (PipelineOptions::incarnation)
 };
 
 /// Wall-clock seconds since each thread last went round its loop (an idle thread still goes
@@ -181,22 +210,45 @@ class FdiPipeline {
   void stop();
 
   // Called from middleware listeners: copy into the input queue, never block.
+  // The seq of each stream is checked here, before the input queue: gaps are losses before
+  // the sidecar (the queue counts its own drops).
   bool push_ins(const InsInput& s) {
     last_ins_ns_.store(now_ns(), std::memory_order_relaxed);
+    ins_seq_.see(s.seq);
     return input_.push(s);
   }
   bool push_rudder(const RudderInput& s) {
     last_rudder_ns_.store(now_ns(), std::memory_order_relaxed);
+    rudder_seq_.see(s.seq);
     return input_.push(s);
   }
-  bool push_ack(const AckInput& a) { return input_.push(a); }
+  /// Acks have their own queue: they never take a sensor sample's place nor go before it.
+  bool push_ack(const AckInput& a) { return acks_.push(a); }
 
   PipelineStatus status() const;
+  /// The incarnation of this run (see PipelineOptions::incarnation).
+  std::uint64_t incarnation() const { return incarnation_; }
+
+  /// Gaps in a stream's sample numbers (lock-free: listeners may call from several threads).
+  /// The first number seen starts the count; a number more than kRestartWindow below the
+  /// highest is taken as the source restarting its count (not a loss); one below it but
+  /// within the window is a late sample of a gap, taken off the count.
+  class SeqGaps {
+   public:
+    static constexpr std::uint64_t kRestartWindow = 1000;
+    void see(std::uint64_t seq);
+    std::uint64_t lost() const { return lost_.load(std::memory_order_relaxed); }
+    std::uint64_t restarts() const { return restarts_.load(std::memory_order_relaxed); }
+
+   private:
+    std::atomic<std::uint64_t> highest_{0}, lost_{0}, restarts_{0};
+  };
+
   /// For a health check: how recently each thread went round its loop.
   PipelineLiveness liveness() const;
 
  private:
-  using Input = std::variant<InsInput, RudderInput, AckInput>;
+  using Input = std::variant<InsInput, RudderInput>;
   using Output = std::variant<FaultEvent, PipelineStatus>;
   struct IdentItem {
     Sample s;
@@ -225,7 +277,7 @@ class FdiPipeline {
   /// What the previous status period's log summary had seen.
   struct ProblemCounts {
     std::uint64_t rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
-                  dropped_inputs = 0;
+                  dropped_inputs = 0, lost = 0, seq_restarts = 0;
   };
 
   static std::int64_t now_ns() {
@@ -240,10 +292,14 @@ class FdiPipeline {
   void accept_rudder(const RudderInput& in);
   void process(const Sample& s);
   void recheck_restored(const Sample& s);
-  void emit(const FaultEvent& ev);
+  /// Hands an event of this run (stamped with its incarnation) to the output queue;
+  /// restored = true: a restored event, re-published with the incarnation that issued it.
+  void emit(const FaultEvent& ev, bool restored = false);
   void publish(const FaultEvent& ev);
   void publish_latest();
   void handle_ack(const AckInput& a);
+  void refuse_ack(const AckInput& a, const std::string& reason, const std::string& detail);
+  void log_ack_summary(bool force);
   void log(int level, const std::string& msg) const;
   void log_input_changes(const PipelineStatus& st);
   PipelineStatus make_status();
@@ -255,6 +311,8 @@ class FdiPipeline {
   LogSink on_log_;
 
   BoundedQueue<Input> input_;
+  BoundedQueue<AckInput> acks_;
+  SeqGaps ins_seq_, rudder_seq_;
   BoundedQueue<IdentItem> ident_q_;
   BoundedQueue<Output> output_;
 
@@ -264,6 +322,9 @@ class FdiPipeline {
                                      FaultLatch(Sensor::kUnknown)};
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
+  std::uint64_t incarnation_ = 0;
+  /// The incarnation of each instance's current event (isolation thread): an ack must name it.
+  std::array<std::uint64_t, 3> current_incarnation_{0, 0, 0};
   std::array<Recheck, 3> recheck_{};
   double last_t_ = kNaN;
   double newest_ins_stamp_ = -1e300;
@@ -276,6 +337,19 @@ class FdiPipeline {
   bool had_ins_ = false;           ///< an INS sample has arrived since start
   bool never_ins_logged_ = false;  ///< "no INS sample since start" was logged
   std::chrono::steady_clock::time_point started_at_{};
+  /// Refused acks (isolation thread): counts since start, and what the current log period
+  /// has not logged yet.
+  struct AckRefusals {
+    std::uint64_t total = 0;
+    std::uint64_t unlogged = 0;  ///< refused in this period after the first (not logged yet)
+    std::uint64_t dropped_logged = 0;
+    std::vector<std::pair<std::string, std::uint64_t>> by_reason;  ///< this period
+    std::string example;       ///< the latest unlogged refusal, in full
+    int logged_in_period = 0;  ///< refusals logged in full in this period
+    std::chrono::steady_clock::time_point period_start{};
+  };
+  AckRefusals refusals_;
+  std::atomic<std::uint64_t> acks_accepted_{0}, acks_refused_{0};
 
   // Identification thread state.
   Identifier ident_;
