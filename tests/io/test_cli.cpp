@@ -1,10 +1,14 @@
 // End-to-end tests of the usv-fdi executable: sim -> CSV -> replay -> JSON Lines, exit
 // codes and messages on bad input.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -50,10 +54,16 @@ class Cli : public ::testing::Test {
 
   std::string path(const std::string& name) const { return dir_ + name; }
 
-  Outcome run(const std::string& args) const {
+  /// Runs `usv-fdi ARGS`, after the shell commands `prefix` (e.g. "ulimit -f 4; ").
+  Outcome run(const std::string& args, const std::string& prefix = "") const {
+    return shell(prefix + "'" + kExe + "' " + args);
+  }
+
+  /// Runs shell commands, collecting their exit code, stdout and stderr.
+  Outcome shell(const std::string& commands) const {
     Outcome r;
     const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const std::string cmd = "'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'";
+    const std::string cmd = "{ " + commands + "; } >'" + out + "' 2>'" + err + "'";
     const int status = std::system(cmd.c_str());
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp(out);
@@ -178,6 +188,64 @@ TEST_F(Cli, InputErrorsExitWith3AndKeepTheRecordsBefore) {
   EXPECT_FALSE(recs.back().at("complete").b);
   EXPECT_EQ(recs.back().at("samples").num, 201.0);
   EXPECT_TRUE(has(recs.back().at("error").str, "bad.csv:203"));
+}
+
+TEST_F(Cli, ReplayRefusesAnOutputThatIsItsInputOrConfig) {
+  const std::string csv = small_csv();
+  const std::string recording = slurp(csv);
+  spit(path("cfg.yaml"), slurp(kSource + "/config/vessels/otter.yaml"));
+  const std::string cfg = path("cfg.yaml");
+  const std::string settings = slurp(cfg);
+  ASSERT_EQ(::symlink(csv.c_str(), path("link.csv").c_str()), 0);
+  ASSERT_EQ(::link(csv.c_str(), path("hard.csv").c_str()), 0);
+  ASSERT_EQ(::symlink(cfg.c_str(), path("link.yaml").c_str()), 0);
+  ASSERT_EQ(std::system(("mkdir -p '" + path("sub") + "'").c_str()), 0);
+  for (const std::string& out : {csv, cfg, path("link.csv"), path("hard.csv"), path("link.yaml"),
+                                 path("sub/../small.csv")}) {
+    const Outcome r =
+        run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + out + "'");
+    EXPECT_EQ(r.code, 4) << out << ": " << r.err;
+    EXPECT_TRUE(has(r.err, "same file")) << r.err;
+    EXPECT_TRUE(has(r.err, out)) << r.err;
+    EXPECT_TRUE(slurp(csv) == recording) << out << ": the recording was changed";
+    EXPECT_TRUE(slurp(cfg) == settings) << out << ": the configuration was changed";
+  }
+  // stdout redirected onto the recording (append, so that the shell does not truncate it)
+  const Outcome r =
+      run("replay --config '" + cfg + "' --input '" + csv + "' --output - >>'" + csv + "'");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(slurp(csv) == recording) << "the recording was changed";
+}
+
+TEST_F(Cli, ReplayThatFailsToWriteLeavesTheExistingOutputUntouched) {
+  const std::string csv = small_csv();
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  const std::string jsonl = path("out.jsonl");
+  spit(jsonl, "the previous run's output\n");
+  // A 4 KiB file-size limit (SIGXFSZ ignored, so write(2) fails with EFBIG) stops the replay
+  // part-way through its output.
+  const Outcome r =
+      run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + jsonl + "'",
+          "trap '' XFSZ; ulimit -f 4; ");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, jsonl)) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(EFBIG))) << r.err;
+  EXPECT_EQ(slurp(jsonl), "the previous run's output\n");
+  // no temporary file is left behind
+  const Outcome ls =
+      shell("ls -A '" + dir_ +
+            "' | grep -v -x -e small.csv -e out.jsonl -e stdout.txt -e stderr.txt || true");
+  EXPECT_EQ(ls.out, "");
+
+  // A successful run replaces it, through a symlink the link stays and its target changes.
+  ASSERT_EQ(::symlink(jsonl.c_str(), path("link.jsonl").c_str()), 0);
+  const Outcome ok = run("replay --config '" + cfg + "' --input '" + csv + "' --output '" +
+                         path("link.jsonl") + "'");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(parse_lines(slurp(jsonl)).back().at("type").str, "summary");
+  struct stat st {};
+  ASSERT_EQ(::lstat(path("link.jsonl").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode));
 }
 
 TEST_F(Cli, SimFaultsAndOptions) {
