@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <utility>
@@ -36,6 +37,32 @@ std::string output_conflict(const ReplayArgs& a) {
     }
   }
   return {};
+}
+
+/// Warns about rejected rows; an error (kExitRejected) when they are most of the input.
+int report_rejections(const std::string& file, const io::RunSummary& sum) {
+  if (sum.rejected == 0) return kExitOk;
+  std::string first = fmt::format("{}:{}", file, sum.first_rejected_line);
+  if (std::isfinite(sum.first_rejected_t)) {
+    first += fmt::format(" has t = {:.17g}", sum.first_rejected_t);
+    if (std::isfinite(sum.first_rejected_after)) {
+      first += fmt::format(", not after t = {:.17g}", sum.first_rejected_after);
+    }
+  } else {
+    first += " has no valid time";
+  }
+  const std::string what = fmt::format(
+      "{} of {} rows ({:.1f} %) rejected (time not after the previous row's: {}, no valid time: "
+      "{}); the first: {}",
+      sum.rejected, sum.samples, 100.0 * static_cast<double>(sum.rejected) / sum.samples,
+      sum.rejected - sum.rejected_no_time, sum.rejected_no_time, first);
+  if (2 * sum.rejected > sum.samples) {
+    spdlog::error("{}: {}. Detection did not see most of the recording (exit {})", file, what,
+                  static_cast<int>(kExitRejected));
+    return kExitRejected;
+  }
+  spdlog::warn("{}: {}", file, what);
+  return kExitOk;
 }
 
 int run_replay(const ReplayArgs& a) {
@@ -83,7 +110,8 @@ int run_replay(const ReplayArgs& a) {
     spdlog::error("{}", e.what());
     return kExitOutput;
   }
-  if (code == kExitOk) {
+  if (code == kExitOk) code = report_rejections(a.input, sum);
+  if (code == kExitOk || code == kExitRejected) {
     spdlog::info(
         "{}: {} samples over {:.1f} s ({} rejected), {} events (raised: accelerometer {}, gyro "
         "{}, unknown {}), estimate {}converged, {} samples frozen",
@@ -101,7 +129,8 @@ void register_replay_command(CommandRegistry& registry) {
       "replay",
       "Replay a CSV of samples (columns t,v,r,delta) through the FDI engine and write JSON "
       "Lines records (event, estimate, summary). Exit codes: 2 config error, 3 input error, "
-      "4 output error (also: the output is the input or the config file).",
+      "4 output error (also: the output is the input or the config file), 5 most rows "
+      "rejected (time missing or not increasing).",
       [args] { return run_replay(*args); });
   sub->add_option("--config", args->config, "engine configuration (YAML)")->required();
   sub->add_option("--input", args->input, "input CSV (header with t,v,r,delta)")->required();

@@ -19,6 +19,7 @@ enum ExitCode : int {
   kExitConfig = 2,   ///< configuration file missing or invalid
   kExitInput = 3,    ///< input data file missing or malformed
   kExitOutput = 4,   ///< output file cannot be written
+  kExitRejected = 5,  ///< replay: the input was read, but most rows were rejected
   kExitUsage = 64,   ///< command line not understood (EX_USAGE)
 };
 

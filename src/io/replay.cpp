@@ -40,7 +40,15 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
     while (input.next(&s)) {
       ++sum.samples;
       events.clear();
-      if (!engine.process(s, &events)) ++sum.rejected;
+      if (!engine.process(s, &events)) {
+        ++sum.rejected;
+        if (!std::isfinite(s.t)) ++sum.rejected_no_time;
+        if (sum.first_rejected_line == 0) {
+          sum.first_rejected_line = input.line();
+          sum.first_rejected_t = s.t;
+          sum.first_rejected_after = last_t;
+        }
+      }
       for (const FaultEvent& e : events) {
         emit(e);
         if (options.auto_ack &&

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -246,6 +247,48 @@ TEST_F(Cli, ReplayThatFailsToWriteLeavesTheExistingOutputUntouched) {
   struct stat st {};
   ASSERT_EQ(::lstat(path("link.jsonl").c_str(), &st), 0);
   EXPECT_TRUE(S_ISLNK(st.st_mode));
+}
+
+/// The CSV text with the time field of data rows [first, last] (1-based, header excluded)
+/// replaced by `t`, and the rows in `repeat` written twice.
+std::string with_times(const std::string& csv, int first, int last, const std::string& t,
+                       const std::set<int>& repeat = {}) {
+  std::istringstream in(csv);
+  std::string line, out;
+  std::getline(in, line);
+  out = line + "\n";
+  for (int row = 1; std::getline(in, line); ++row) {
+    if (row >= first && row <= last) line = t + line.substr(line.find(','));
+    out += line + "\n";
+    if (repeat.count(row)) out += line + "\n";
+  }
+  return out;
+}
+
+TEST_F(Cli, ReplayOfMostlyRejectedRowsExitsWith5) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  const std::string csv = slurp(small_csv());  // 301 rows, t = 0 .. 30 s
+  // The INS clock sticks at 5 s from row 52 on: 250 rows do not advance.
+  spit(path("stuck.csv"), with_times(csv, 52, 301, "5"));
+  const std::string jsonl = path("stuck.jsonl");
+  Outcome r = run("replay --config '" + cfg + "' --input '" + path("stuck.csv") + "' --output '" +
+                  jsonl + "'");
+  EXPECT_EQ(r.code, 5) << r.err;
+  EXPECT_TRUE(has(r.err, "250 of 301 rows")) << r.err;
+  EXPECT_TRUE(has(r.err, "stuck.csv:53")) << r.err;  // the first rejected row's line
+  EXPECT_TRUE(has(r.err, "error")) << r.err;
+  const auto recs = parse_lines(slurp(jsonl));  // the records are still written
+  ASSERT_FALSE(recs.empty());
+  EXPECT_EQ(recs.back().at("rejected").num, 250.0);
+
+  // Three repeated rows: a warning, exit 0.
+  spit(path("dup.csv"), with_times(csv, 0, 0, "", {100, 200, 250}));
+  r = run("replay --config '" + cfg + "' --input '" + path("dup.csv") + "' --output '" + jsonl +
+          "'");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warn")) << r.err;
+  EXPECT_TRUE(has(r.err, "3 of 304 rows")) << r.err;
+  EXPECT_TRUE(has(r.err, "dup.csv:102")) << r.err;
 }
 
 TEST_F(Cli, SimFaultsAndOptions) {
