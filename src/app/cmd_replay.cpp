@@ -110,7 +110,14 @@ int run_replay(const ReplayArgs& a) {
     spdlog::error("{}", e.what());
     return kExitOutput;
   }
+  for (const std::string& w : sum.warnings) spdlog::warn("{}: {}", a.input, w);
   if (code == kExitOk) code = report_rejections(a.input, sum);
+  if (code == kExitOk && !sum.not_converged.empty()) {
+    spdlog::warn(
+        "{}: after {:.1f} s of data the estimate of A has {} (detection is armed only "
+        "after convergence)",
+        a.input, sum.duration_s, sum.not_converged);
+  }
   if (code == kExitOk || code == kExitRejected) {
     spdlog::info(
         "{}: {} samples over {:.1f} s ({} rejected), {} events (raised: accelerometer {}, gyro "

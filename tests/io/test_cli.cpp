@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -289,6 +290,44 @@ TEST_F(Cli, ReplayOfMostlyRejectedRowsExitsWith5) {
   EXPECT_TRUE(has(r.err, "warn")) << r.err;
   EXPECT_TRUE(has(r.err, "3 of 304 rows")) << r.err;
   EXPECT_TRUE(has(r.err, "dup.csv:102")) << r.err;
+}
+
+TEST_F(Cli, ReplayWarnsOfUnitMistakesAndSaysWhyItDidNotConverge) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  std::istringstream in(slurp(small_csv()));  // 30 s at 10 Hz
+  std::string line, ms, deg, empty;
+  std::getline(in, line);
+  ms = deg = empty = line + "\n";
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    f.resize(11);
+    const auto row = [&f] {
+      std::string s;
+      for (const std::string& x : f) s += (s.empty() ? "" : ",") + x;
+      return s + "\n";
+    };
+    const std::string t = f[0], delta = f[3];
+    f[0] = std::to_string(std::stod(t) * 1000.0);
+    ms += row();
+    f[0] = t;
+    f[3] = std::to_string(std::stod(delta) * 180.0 / M_PI);
+    deg += row();
+    f[3] = "";
+    empty += row();
+  }
+  const std::pair<const char*, const std::string*> cases[] = {
+      {"probably in milliseconds", &ms}, {"probably in degrees", &deg}, {"no value", &empty}};
+  for (const auto& [expect, text] : cases) {
+    spit(path("in.csv"), *text);
+    const Outcome r = run("replay --config '" + cfg + "' --input '" + path("in.csv") +
+                          "' --output '" + path("out.jsonl") + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(has(r.err, "warning: " + path("in.csv") + ": column")) << r.err;
+    EXPECT_TRUE(has(r.err, expect)) << r.err;
+    EXPECT_TRUE(has(r.err, "has not converged")) << r.err;
+  }
 }
 
 TEST_F(Cli, SimFaultsAndOptions) {

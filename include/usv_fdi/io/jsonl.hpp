@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "usv_fdi/core/engine.hpp"
 
@@ -46,7 +47,10 @@ struct RunSummary {
   std::uint64_t frozen_samples = 0;
   double duration_s = 0.0;  ///< last minus first sample time [s, data time]
   bool complete = true;     ///< false: the input ended in an error
-  std::string error;        ///< that error (only when !complete)
+  // For the command's messages, not in the JSON record:
+  std::vector<std::string> warnings;  ///< PlausibilityCheck's findings on the input
+  std::string not_converged;          ///< convergence_report() at the end ("" if converged)
+  std::string error;                  ///< that error (only when !complete)
 };
 
 class JsonlWriter {
