@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
@@ -71,6 +73,7 @@ ServiceConfig load_service_config(const std::string& path) {
   if (s && !s.IsMap()) fail(path, s, "", "must be a mapping");
   bool have_mmsi = false;
   YAML::Node input_timeout_node;
+  std::vector<std::pair<std::string, YAML::Node>> topic_nodes;  ///< topics given, in order
   if (s) {
     for (const auto& kv : s) {
       const std::string key = kv.first.as<std::string>();
@@ -95,6 +98,7 @@ ServiceConfig load_service_config(const std::string& path) {
         for (const auto& t : v) {
           const std::string tk = t.first.as<std::string>();
           const std::string name = get<std::string>(path, t.second, key + "." + tk, "a topic name");
+          topic_nodes.emplace_back(tk, t.second);
           if (tk == "ins")
             cfg.dds.topics.ins = name;
           else if (tk == "rudder")
@@ -161,6 +165,26 @@ ServiceConfig load_service_config(const std::string& path) {
     }
   }
   (void)have_mmsi;
+  // Two roles on one topic name would make the DDS participant fail later (exit 1).
+  const std::pair<const char*, const std::string*> topics[] = {
+      {"ins", &cfg.dds.topics.ins},
+      {"rudder", &cfg.dds.topics.rudder},
+      {"fault_event", &cfg.dds.topics.fault_event},
+      {"fault_ack", &cfg.dds.topics.fault_ack},
+      {"status", &cfg.dds.topics.status}};
+  for (std::size_t k = 0; k < topic_nodes.size(); ++k) {  // in the file's order
+    const auto& [key, node] = topic_nodes[k];
+    for (const auto& [other, name] : topics) {
+      if (other == key || *name != node.Scalar()) continue;
+      bool later = false;  // `other` is given further down: it is the one to blame
+      for (std::size_t j = k + 1; j < topic_nodes.size(); ++j)
+        later |= topic_nodes[j].first == other;
+      if (!later) {
+        fail(path, node, "topics." + key,
+             std::string("the same topic name as service.topics.") + other);
+      }
+    }
+  }
   // A silent INS is reported as stale faults: the silence must outlast the stale check.
   if (input_timeout_node && cfg.pipeline.input_timeout < cfg.engine.isolation.stale_timeout) {
     char why[128];

@@ -330,6 +330,30 @@ TEST_F(Cli, ReplayWarnsOfUnitMistakesAndSaysWhyItDidNotConverge) {
   }
 }
 
+TEST_F(Cli, FileErrorsGiveTheSystemsReason) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  const std::string nowhere = path("no/such/dir/out.csv");
+  Outcome r = run("sim --vessel otter --duration 5 --output '" + nowhere + "'");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, nowhere)) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+  // sim's output cut short by a 4 KiB file-size limit
+  r = run("sim --vessel otter --duration 60 --output '" + path("big.csv") + "'",
+          "trap '' XFSZ; ulimit -f 4; ");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(EFBIG))) << r.err;
+  const std::string csv = small_csv();
+  r = run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + nowhere + "'");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+  r = run("replay --config '" + path("none.yaml") + "' --input '" + csv + "'");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+  r = run("replay --config '" + cfg + "' --input '" + path("none.csv") + "'");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+}
+
 TEST_F(Cli, SimFaultsAndOptions) {
   const std::string csv = path("f.csv");
   Outcome r =
