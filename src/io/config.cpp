@@ -20,6 +20,16 @@
 
 namespace usvfdi::io {
 namespace {
+class Loader;
+}  // namespace
+
+struct ConfigValue::Impl {
+  const Loader* loader;
+  YAML::Node node;
+  std::string path;
+};
+
+namespace {
 
 /// Short, single-line rendering of a node for error messages.
 std::string render(const YAML::Node& node) {
@@ -69,7 +79,9 @@ const Range kAnything{};
 /// Parses one YAML document into an EngineConfig; every problem names file, key, line, value.
 class Loader {
  public:
-  explicit Loader(std::string file) : file_(std::move(file)) {}
+  explicit Loader(std::string file, const ConfigValue::Table* extra = nullptr)
+      : file_(std::move(file)), extra_(extra) {}
+  const std::string& file() const { return file_; }
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
                          const std::string& reason) const {
@@ -286,11 +298,11 @@ class Loader {
     const auto sub = [this](const std::map<std::string, Handler>& h) {
       return [this, &h](const YAML::Node& n, const std::string& p) { section(n, p, h); };
     };
-    const std::map<std::string, Handler> top = {
+    std::map<std::string, Handler> top = {
         {"model", sub(model)},
         {"identification", sub(identification)},
         {"isolation", sub(isolation)},
-        // Parsed by the DDS service; accepted here as any mapping.
+        // Parsed by the DDS service (through `extra`); otherwise accepted as any mapping.
         {"service",
          [this](const YAML::Node& n, const std::string& p) {
            remember(n, p);
@@ -299,6 +311,14 @@ class Loader {
            }
          }},
     };
+    if (extra_ != nullptr) {
+      for (const auto& [key, handler] : *extra_) {
+        top[key] = [this, h = handler](const YAML::Node& n, const std::string& p) {
+          const ConfigValue::Impl impl{this, n, p};
+          h(ConfigValue(&impl));
+        };
+      }
+    }
 
     if (!root.IsDefined() || root.IsNull()) fail_missing(root, "model.B");
     section(root, "", top);
@@ -355,10 +375,12 @@ class Loader {
     std::string text;  ///< the value as written
   };
   std::string file_;
+  const ConfigValue::Table* extra_ = nullptr;
   std::map<std::string, Seen> seen_;
 };
 
-EngineConfig load_node(const std::string& name, const std::function<YAML::Node()>& parse) {
+EngineConfig load_node(const std::string& name, const std::function<YAML::Node()>& parse,
+                       const ConfigValue::Table* extra = nullptr) {
   YAML::Node root;
   try {
     root = parse();
@@ -372,7 +394,7 @@ EngineConfig load_node(const std::string& name, const std::function<YAML::Node()
     throw ConfigError(name + ": " + e.what());
   }
   try {
-    return Loader(name).load(root);
+    return Loader(name, extra).load(root);
   } catch (const ConfigError&) {
     throw;
   } catch (const YAML::Exception& e) {  // defensive: a yaml-cpp surprise still names the file
@@ -380,9 +402,19 @@ EngineConfig load_node(const std::string& name, const std::function<YAML::Node()
   }
 }
 
-}  // namespace
+/// The one document of a YAML text (a second one is an error: it would be ignored).
+YAML::Node single_document(const std::string& yaml, const std::string& name) {
+  std::vector<YAML::Node> docs = YAML::LoadAll(yaml);
+  if (docs.size() > 1) {
+    std::string where = name;
+    if (docs[1].Mark().line >= 0) where += ":" + std::to_string(docs[1].Mark().line + 1);
+    throw ConfigError(where + ": a second YAML document (after '---'): one file holds one " +
+                      "configuration");
+  }
+  return docs.empty() ? YAML::Node() : docs[0];
+}
 
-EngineConfig load_engine_config(const std::string& path) {
+std::string read_file(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     throw ConfigError(path + ": cannot read: " + std::strerror(errno));
@@ -393,20 +425,110 @@ EngineConfig load_engine_config(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw ConfigError(path + ": read error: " + std::strerror(errno));
-  return load_engine_config_from_string(text.str(), path);
+  return text.str();
+}
+
+/// A value as the service's messages show it: the scalar as written, <list>, <mapping>.
+std::string plain(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "null";
+  if (n.IsScalar()) return n.Scalar();
+  return n.IsSequence() ? "<list>" : "<mapping>";
+}
+
+}  // namespace
+
+const std::string& ConfigValue::path() const { return impl_->path; }
+
+bool ConfigValue::is_null() const { return !impl_->node.IsDefined() || impl_->node.IsNull(); }
+
+std::string ConfigValue::where() const {
+  const YAML::Node& n = impl_->node;
+  std::string w = impl_->loader->file();
+  if (n.IsDefined() && n.Mark().line >= 0) w += ":" + std::to_string(n.Mark().line + 1);
+  return w + ": " + impl_->path + " = " + plain(n);
+}
+
+void ConfigValue::fail(const std::string& reason) const {
+  throw ConfigError(where() + ": " + reason);
+}
+
+double ConfigValue::number(double lo, double hi, const std::string& what,
+                           const std::string& range) const {
+  double x = 0.0;
+  if (!impl_->node.IsScalar() || !YAML::convert<double>::decode(impl_->node, x) ||
+      !std::isfinite(x)) {
+    fail("must be " + what);
+  }
+  if (x < lo || x > hi) fail("must be " + (range.empty() ? what : range));
+  return x;
+}
+
+long long ConfigValue::integer(long long lo, long long hi, const std::string& what,
+                               const std::string& range) const {
+  long long x = 0;
+  if (!impl_->node.IsScalar() || !YAML::convert<long long>::decode(impl_->node, x)) {
+    fail("must be " + what);
+  }
+  if (x < lo || x > hi) fail("must be " + (range.empty() ? what : range));
+  return x;
+}
+
+bool ConfigValue::boolean() const {
+  bool x = false;
+  if (!impl_->node.IsScalar() || !YAML::convert<bool>::decode(impl_->node, x)) {
+    fail("must be true or false");
+  }
+  return x;
+}
+
+std::string ConfigValue::text(const std::string& what) const {
+  if (!impl_->node.IsScalar()) fail("must be " + what);
+  return impl_->node.Scalar();
+}
+
+std::vector<std::string> ConfigValue::strings() const {
+  if (!impl_->node.IsSequence()) fail("must be a list of strings");
+  std::vector<std::string> out;
+  for (const YAML::Node& e : impl_->node) {
+    const Impl item{impl_->loader, e, impl_->path};
+    out.push_back(ConfigValue(&item).text("a string"));
+  }
+  return out;
+}
+
+void ConfigValue::section(const Table& table, const std::string& unknown, bool show_key) const {
+  if (is_null()) return;
+  if (!impl_->node.IsMap()) fail("must be a mapping");
+  std::set<std::string> keys;
+  for (const auto& kv : impl_->node) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : plain(kv.first);
+    const Impl item{impl_->loader, kv.second, impl_->path + "." + key};
+    const ConfigValue value(&item);
+    if (!keys.insert(key).second) value.fail("key given twice");
+    const auto it = table.find(key);
+    if (it == table.end()) {
+      std::string allowed;
+      for (const auto& h : table) allowed += (allowed.empty() ? "" : ", ") + h.first;
+      const Impl name{impl_->loader, show_key ? kv.first : kv.second, item.path};
+      ConfigValue(&name).fail(unknown + " (expected one of: " + allowed + ")");
+    }
+    it->second(value);
+  }
+}
+
+EngineConfig load_engine_config(const std::string& path, const ConfigValue::Table& extra) {
+  const std::string text = read_file(path);
+  return load_node(
+      path, [&] { return single_document(text, path); }, &extra);
+}
+
+EngineConfig load_engine_config(const std::string& path) {
+  const std::string text = read_file(path);
+  return load_engine_config_from_string(text, path);
 }
 
 EngineConfig load_engine_config_from_string(const std::string& yaml, const std::string& name) {
-  return load_node(name, [&yaml, &name] {
-    std::vector<YAML::Node> docs = YAML::LoadAll(yaml);
-    if (docs.size() > 1) {  // a second document would be ignored silently
-      std::string where = name;
-      if (docs[1].Mark().line >= 0) where += ":" + std::to_string(docs[1].Mark().line + 1);
-      throw ConfigError(where + ": a second YAML document (after '---'): one file holds one " +
-                        "configuration");
-    }
-    return docs.empty() ? YAML::Node() : docs[0];
-  });
+  return load_node(name, [&] { return single_document(yaml, name); });
 }
 
 }  // namespace usvfdi::io
