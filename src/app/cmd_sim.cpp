@@ -20,6 +20,7 @@
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/csv.hpp"
+#include "usv_fdi/io/output_file.hpp"
 #include "usv_fdi/io/scenarios.hpp"
 #include "usv_fdi/sim/voyage.hpp"
 #ifdef USV_FDI_APP_WITH_DDS
@@ -237,26 +238,25 @@ int run_sim(const SimArgs& a) {
     return kExitUsage;
   }
 
-  std::ofstream file;
   const bool to_stdout = a.output == "-";
-  if (!to_stdout) {
-    file.open(a.output, std::ios::binary | std::ios::trunc);
-    if (!file) {
-      spdlog::error("{}: cannot open for writing", a.output);
-      return kExitOutput;
-    }
+  std::unique_ptr<io::OutputFile> output;  // a temporary file renamed at the end
+  try {
+    output = std::make_unique<io::OutputFile>(a.output);
+  } catch (const io::OutputError& e) {
+    spdlog::error("{}", e.what());
+    return kExitOutput;
   }
-  std::ostream& os = to_stdout ? std::cout : file;
-  io::SimCsvWriter writer(os);
+  io::SimCsvWriter writer(output->stream());
   SimRow row;
   std::size_t rows = 0;
   while (sim->next(&row)) {
     writer.write(row);
     ++rows;
   }
-  os.flush();
-  if (!os) {
-    spdlog::error("{}: write failed", a.output);
+  try {
+    output->commit();
+  } catch (const io::OutputError& e) {
+    spdlog::error("{}", e.what());  // names the file and the system's reason
     return kExitOutput;
   }
   spdlog::info(

@@ -177,7 +177,7 @@ SimConfig paper_scenario(const VesselModel& vessel, double rate_hz, std::uint64_
   c.rate_hz = rate_hz;
   c.duration = 100.0;
   c.seed = seed;
-  c.steering = Steering::kSine;  // the paper does not say; a smooth rudder sine, as in DESIGN.md
+  c.steering = Steering::kSine;  // the paper does not say: a smooth rudder sine (docs/design.md)
   const double sv = vessel.sigma_v, sr = vessel.sigma_r;
   c.faults.push_back({Sensor::kGyro, FaultKind::kBias, 20.0, 40.0, 10.0 * sr, 2.0});
   c.faults.push_back({Sensor::kAccelerometer, FaultKind::kBias, 60.0, 80.0, 10.0 * sv, 2.0});

@@ -1,10 +1,12 @@
-#include <yaml-cpp/yaml.h>
-
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
@@ -14,41 +16,9 @@
 #endif
 
 namespace usvfdi::service {
-namespace {
 
 using io::ConfigError;
-
-[[noreturn]] void fail(const std::string& file, const YAML::Node& n, const std::string& key,
-                       const std::string& why) {
-  std::string value;
-  try {
-    value = n.IsScalar() ? n.Scalar() : (n.IsSequence() ? "<list>" : "<mapping>");
-  } catch (...) {
-    value = "?";
-  }
-  throw ConfigError(file + ":" + std::to_string(n.Mark().line + 1) + ": service." + key + " = " +
-                    value + ": " + why);
-}
-
-template <typename T>
-T get(const std::string& file, const YAML::Node& n, const std::string& key, const char* what) {
-  if (!n.IsScalar()) fail(file, n, key, std::string("must be ") + what);
-  try {
-    return n.as<T>();
-  } catch (const YAML::Exception&) {
-    fail(file, n, key, std::string("must be ") + what);
-  }
-}
-
-std::vector<std::string> strings(const std::string& file, const YAML::Node& n,
-                                 const std::string& key) {
-  if (!n.IsSequence()) fail(file, n, key, "must be a list of strings");
-  std::vector<std::string> out;
-  for (const YAML::Node& e : n) out.push_back(get<std::string>(file, e, key, "a string"));
-  return out;
-}
-
-}  // namespace
+using io::ConfigValue;
 
 std::string default_qos_profiles() {
   if (const char* env = std::getenv("USV_FDI_QOS_PROFILES")) return env;
@@ -58,117 +28,145 @@ std::string default_qos_profiles() {
 ServiceConfig load_service_config(const std::string& path) {
   ServiceConfig cfg;
   cfg.config_file = path;
-  cfg.engine = io::load_engine_config(path);  // also reports a missing file / bad YAML
-  const YAML::Node root = YAML::LoadFile(path);
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  std::string qos = default_qos_profiles();
   cfg.state_dir = kDefaultStateDir;
-  const auto relative_to_config = [&](const std::string& p) {
+  std::string qos = default_qos_profiles();
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  const auto relative_to_config = [&dir](const std::string& p) {
     const std::filesystem::path fp(p);
     return (fp.is_absolute() ? fp : dir / fp).lexically_normal().string();
   };
-  const YAML::Node s = root["service"];
-  if (s && !s.IsMap()) fail(path, s, "", "must be a mapping");
-  bool have_mmsi = false;
-  YAML::Node input_timeout_node;
-  if (s) {
-    for (const auto& kv : s) {
-      const std::string key = kv.first.as<std::string>();
-      const YAML::Node& v = kv.second;
-      if (key == "mmsi") {
-        const auto m = get<long long>(path, v, key, "an MMSI (1..999999999)");
-        if (m < 1 || m > 999999999) fail(path, v, key, "must be an MMSI (1..999999999)");
-        cfg.mmsi = static_cast<std::uint32_t>(m);
-        have_mmsi = true;
-      } else if (key == "domain_id") {
-        const auto d = get<long long>(path, v, key, "an integer 0..232");
-        if (d < 0 || d > 232) fail(path, v, key, "must be 0..232 (Fast DDS port mapping)");
-        cfg.dds.domain_id = static_cast<std::uint32_t>(d);
-      } else if (key == "qos_profiles") {
-        const auto p = std::filesystem::path(get<std::string>(path, v, key, "a file path"));
-        qos = (p.is_absolute() ? p : dir / p).lexically_normal().string();
-        if (!std::filesystem::exists(qos)) fail(path, v, key, "no such file: " + qos);
-      } else if (key == "participant_profile") {
-        cfg.dds.participant_profile = get<std::string>(path, v, key, "a profile name");
-      } else if (key == "topics") {
-        if (!v.IsMap()) fail(path, v, key, "must be a mapping of topic names");
-        for (const auto& t : v) {
-          const std::string tk = t.first.as<std::string>();
-          const std::string name = get<std::string>(path, t.second, key + "." + tk, "a topic name");
-          if (tk == "ins")
-            cfg.dds.topics.ins = name;
-          else if (tk == "rudder")
-            cfg.dds.topics.rudder = name;
-          else if (tk == "fault_event")
-            cfg.dds.topics.fault_event = name;
-          else if (tk == "fault_ack")
-            cfg.dds.topics.fault_ack = name;
-          else if (tk == "status")
-            cfg.dds.topics.status = name;
-          else
-            fail(path, t.second, key + "." + tk,
-                 "unknown topic (ins, rudder, fault_event, fault_ack, status)");
-        }
-      } else if (key == "partitions") {
-        cfg.dds.publisher_partitions = strings(path, v, key);
-        cfg.dds.subscriber_partitions = cfg.dds.publisher_partitions;
-      } else if (key == "reliable_inputs") {
-        cfg.reliable_inputs = get<bool>(path, v, key, "true or false");
-      } else if (key == "lockstep") {
-        cfg.pipeline.lockstep = get<bool>(path, v, key, "true or false");
-      } else if (key == "status_rate") {
-        const double r = get<double>(path, v, key, "a rate in Hz");
-        if (!(r > 0) || !std::isfinite(r)) fail(path, v, key, "must be a positive rate in Hz");
-        cfg.pipeline.status_period = 1.0 / r;
-      } else if (key == "log_level") {
-        static const std::set<std::string> levels = {"trace", "debug",    "info", "warn",
-                                                     "error", "critical", "off"};
-        cfg.log_level = get<std::string>(path, v, key, "a log level");
-        if (!levels.count(cfg.log_level)) {
-          fail(path, v, key, "must be one of trace, debug, info, warn, error, critical, off");
-        }
-      } else if (key == "authorised_operators") {
-        cfg.pipeline.authorised_operators = strings(path, v, key);
-      } else if (key == "input_queue") {
-        const auto n = get<long long>(path, v, key, "a queue length");
-        if (n < 1 || n > 1000000) fail(path, v, key, "must be 1..1000000");
-        cfg.pipeline.input_capacity = static_cast<std::size_t>(n);
-      } else if (key == "rudder_wait" || key == "rudder_timeout" || key == "input_timeout" ||
-                 key == "restore_recheck") {
-        const double x = get<double>(path, v, key, "a time in seconds");
-        if (!(x > 0) || !std::isfinite(x)) fail(path, v, key, "must be a positive time in s");
-        (key == "rudder_wait"      ? cfg.pipeline.rudder_wait
-         : key == "rudder_timeout" ? cfg.pipeline.rudder_timeout
-         : key == "input_timeout"  ? cfg.pipeline.input_timeout
-                                   : cfg.pipeline.restore_recheck) = x;
-        if (key == "input_timeout") input_timeout_node = v;
-      } else if (key == "state_dir") {
-        // null or "": no persistence.
-        const std::string d =
-            v.IsNull() ? std::string() : get<std::string>(path, v, key, "a directory");
-        cfg.state_dir = d.empty() ? d : relative_to_config(d);
-        cfg.state_dir_explicit = true;
-        std::error_code ec;
-        if (!cfg.state_dir.empty() && std::filesystem::exists(cfg.state_dir, ec) &&
-            !std::filesystem::is_directory(cfg.state_dir, ec)) {
-          fail(path, v, key, "not a directory: " + cfg.state_dir);
-        }
-      } else if (key == "health_file") {
-        const std::string f =
-            v.IsNull() ? std::string() : get<std::string>(path, v, key, "a file path");
-        cfg.health_file = f.empty() ? f : relative_to_config(f);
-      } else {
-        fail(path, kv.first, key, "unknown key");
+  std::string input_timeout_at;  ///< where service.input_timeout was given ("" : not given)
+  std::vector<std::pair<std::string, std::string>> topics_given;  ///< (key, where), in order
+  const auto positive_time = [](double* out) {
+    return [out](const ConfigValue& v) {
+      *out = v.number(1e-9, 1e9, "a time in seconds", "a positive time in s");
+    };
+  };
+  const auto topic = [&topics_given](std::string* out) {
+    return [out, &topics_given](const ConfigValue& v) {
+      *out = v.text("a topic name");
+      topics_given.emplace_back(v.path(), v.where());
+    };
+  };
+  const ConfigValue::Table topics = {
+      {"ins", topic(&cfg.dds.topics.ins)},
+      {"rudder", topic(&cfg.dds.topics.rudder)},
+      {"fault_event", topic(&cfg.dds.topics.fault_event)},
+      {"fault_ack", topic(&cfg.dds.topics.fault_ack)},
+      {"status", topic(&cfg.dds.topics.status)},
+  };
+  const ConfigValue::Table service = {
+      {"mmsi",
+       [&](const ConfigValue& v) {
+         cfg.mmsi = static_cast<std::uint32_t>(v.integer(1, 999999999, "an MMSI (1..999999999)"));
+       }},
+      {"domain_id",
+       [&](const ConfigValue& v) {
+         cfg.dds.domain_id = static_cast<std::uint32_t>(
+             v.integer(0, 232, "an integer 0..232", "0..232 (Fast DDS port mapping)"));
+       }},
+      {"qos_profiles",
+       [&](const ConfigValue& v) {
+         qos = relative_to_config(v.text("a file path"));
+         std::error_code ec;
+         if (!std::filesystem::exists(qos, ec)) v.fail("no such file: " + qos);
+       }},
+      {"participant_profile",
+       [&](const ConfigValue& v) { cfg.dds.participant_profile = v.text("a profile name"); }},
+      {"topics",
+       [&](const ConfigValue& v) {
+         if (v.is_null()) v.fail("must be a mapping of topic names");
+         v.section(topics, "unknown topic", false);
+       }},
+      {"partitions",
+       [&](const ConfigValue& v) {
+         cfg.dds.publisher_partitions = v.strings();
+         cfg.dds.subscriber_partitions = cfg.dds.publisher_partitions;
+       }},
+      {"reliable_inputs", [&](const ConfigValue& v) { cfg.reliable_inputs = v.boolean(); }},
+      {"lockstep", [&](const ConfigValue& v) { cfg.pipeline.lockstep = v.boolean(); }},
+      {"status_rate",
+       [&](const ConfigValue& v) {
+         cfg.pipeline.status_period =
+             1.0 / v.number(1e-9, 1e9, "a rate in Hz", "a positive rate in Hz");
+       }},
+      {"log_level",
+       [&](const ConfigValue& v) {
+         static const std::set<std::string> levels = {"trace", "debug",    "info", "warn",
+                                                      "error", "critical", "off"};
+         cfg.log_level = v.text("a log level");
+         if (!levels.count(cfg.log_level)) {
+           v.fail("must be one of trace, debug, info, warn, error, critical, off");
+         }
+       }},
+      {"authorised_operators",
+       [&](const ConfigValue& v) { cfg.pipeline.authorised_operators = v.strings(); }},
+      {"input_queue",
+       [&](const ConfigValue& v) {
+         cfg.pipeline.input_capacity =
+             static_cast<std::size_t>(v.integer(1, 1000000, "a queue length", "1..1000000"));
+       }},
+      {"rudder_wait", positive_time(&cfg.pipeline.rudder_wait)},
+      {"rudder_timeout", positive_time(&cfg.pipeline.rudder_timeout)},
+      {"input_timeout",
+       [&](const ConfigValue& v) {
+         positive_time (&cfg.pipeline.input_timeout)(v);
+         input_timeout_at = v.where();
+       }},
+      {"restore_recheck", positive_time(&cfg.pipeline.restore_recheck)},
+      {"state_dir",
+       [&](const ConfigValue& v) {
+         // null or "": no persistence.
+         const std::string d = v.is_null() ? std::string() : v.text("a directory");
+         cfg.state_dir = d.empty() ? d : relative_to_config(d);
+         cfg.state_dir_explicit = true;
+         std::error_code ec;
+         if (!cfg.state_dir.empty() && std::filesystem::exists(cfg.state_dir, ec) &&
+             !std::filesystem::is_directory(cfg.state_dir, ec)) {
+           v.fail("not a directory: " + cfg.state_dir);
+         }
+       }},
+      {"health_file",
+       [&](const ConfigValue& v) {
+         const std::string f = v.is_null() ? std::string() : v.text("a file path");
+         cfg.health_file = f.empty() ? f : relative_to_config(f);
+       }},
+  };
+  cfg.engine = io::load_engine_config(
+      path, {{"service", [&service](const ConfigValue& v) { v.section(service); }}});
+
+  // A silent INS is reported as stale faults: the silence must outlast the stale check.
+  if (!input_timeout_at.empty() &&
+      cfg.pipeline.input_timeout < cfg.engine.isolation.stale_timeout) {
+    char why[128];
+    std::snprintf(why, sizeof why, ": must be at least isolation.stale_timeout (%g s)",
+                  cfg.engine.isolation.stale_timeout);
+    throw ConfigError(input_timeout_at + why);
+  }
+  // Two roles on one topic name would make the DDS participant fail later (exit 1); the one
+  // given last in the file is named.
+  const std::pair<const char*, const std::string*> names[] = {
+      {"ins", &cfg.dds.topics.ins},
+      {"rudder", &cfg.dds.topics.rudder},
+      {"fault_event", &cfg.dds.topics.fault_event},
+      {"fault_ack", &cfg.dds.topics.fault_ack},
+      {"status", &cfg.dds.topics.status}};
+  for (std::size_t k = 0; k < topics_given.size(); ++k) {
+    const std::string key = topics_given[k].first.substr(topics_given[k].first.rfind('.') + 1);
+    const std::string& name = *std::find_if(std::begin(names), std::end(names), [&](const auto& n) {
+                                 return key == n.first;
+                               })->second;
+    for (const auto& [other, other_name] : names) {
+      if (key == other || *other_name != name) continue;
+      bool later = false;  // `other` is given further down: it is the one to name
+      for (std::size_t j = k + 1; j < topics_given.size(); ++j) {
+        later |= topics_given[j].first == "service.topics." + std::string(other);
+      }
+      if (!later) {
+        throw ConfigError(topics_given[k].second + ": the same topic name as service.topics." +
+                          other);
       }
     }
-  }
-  (void)have_mmsi;
-  // A silent INS is reported as stale faults: the silence must outlast the stale check.
-  if (input_timeout_node && cfg.pipeline.input_timeout < cfg.engine.isolation.stale_timeout) {
-    char why[128];
-    std::snprintf(why, sizeof why, "must be at least isolation.stale_timeout (%g s)",
-                  cfg.engine.isolation.stale_timeout);
-    fail(path, input_timeout_node, "input_timeout", why);
   }
   cfg.dds.profiles_file = qos;
   return cfg;

@@ -1,12 +1,16 @@
 #include "usv_fdi/io/config.hpp"
 
+#include <sys/stat.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -15,6 +19,16 @@
 #include <vector>
 
 namespace usvfdi::io {
+namespace {
+class Loader;
+}  // namespace
+
+struct ConfigValue::Impl {
+  const Loader* loader;
+  YAML::Node node;
+  std::string path;
+};
+
 namespace {
 
 /// Short, single-line rendering of a node for error messages.
@@ -40,10 +54,34 @@ const char* type_name(const YAML::Node& node) {
   return "a mapping";
 }
 
+std::string format_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", x);
+  return buf;
+}
+
+/// The values a number may take [lo, hi], and its unit for messages.
+struct Range {
+  double lo = -std::numeric_limits<double>::max();
+  double hi = std::numeric_limits<double>::max();
+  const char* unit = "";
+  /// " [lo, hi] unit", or "" for any finite number.
+  std::string text() const {
+    if (lo == -std::numeric_limits<double>::max() && hi == std::numeric_limits<double>::max()) {
+      return "";
+    }
+    return " [" + format_number(lo) + ", " + format_number(hi) + "]" +
+           (*unit ? std::string(" ") + unit : std::string());
+  }
+};
+const Range kAnything{};
+
 /// Parses one YAML document into an EngineConfig; every problem names file, key, line, value.
 class Loader {
  public:
-  explicit Loader(std::string file) : file_(std::move(file)) {}
+  explicit Loader(std::string file, const ConfigValue::Table* extra = nullptr)
+      : file_(std::move(file)), extra_(extra) {}
+  const std::string& file() const { return file_; }
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& path,
                          const std::string& reason) const {
@@ -62,19 +100,22 @@ class Loader {
     throw ConfigError(os.str());
   }
 
-  double number(const YAML::Node& n, const std::string& path) {
+  double number(const YAML::Node& n, const std::string& path, const Range& range = kAnything) {
     remember(n, path);
     if (!n.IsScalar()) fail(n, path, std::string("expected a number, got ") + type_name(n));
     double x = 0.0;
     if (!YAML::convert<double>::decode(n, x)) fail(n, path, "expected a number");
+    if (!std::isfinite(x)) fail(n, path, "must be a finite number" + range.text());
+    checks_.push_back({n, path, x, range});
     return x;
   }
 
-  int integer(const YAML::Node& n, const std::string& path) {
+  int integer(const YAML::Node& n, const std::string& path, const Range& range = kAnything) {
     remember(n, path);
     if (!n.IsScalar()) fail(n, path, std::string("expected an integer, got ") + type_name(n));
     int x = 0;
     if (!YAML::convert<int>::decode(n, x)) fail(n, path, "expected an integer");
+    checks_.push_back({n, path, static_cast<double>(x), range});
     return x;
   }
 
@@ -93,7 +134,8 @@ class Loader {
   }
 
   template <int N>
-  Eigen::Matrix<double, N, 1> vector(const YAML::Node& n, const std::string& path) {
+  Eigen::Matrix<double, N, 1> vector(const YAML::Node& n, const std::string& path,
+                                     const Range& range = kAnything) {
     remember(n, path);
     if (!n.IsSequence() || n.size() != static_cast<std::size_t>(N)) {
       fail(n, path,
@@ -102,7 +144,9 @@ class Loader {
                                : std::string(type_name(n))));
     }
     Eigen::Matrix<double, N, 1> v;
-    for (int i = 0; i < N; ++i) v(i) = number(n[i], path + "[" + std::to_string(i) + "]");
+    for (int i = 0; i < N; ++i) {
+      v(i) = number(n[i], path + "[" + std::to_string(i) + "]", range);
+    }
     remember(n, path);  // the element paths must not shadow the list's own mark
     return v;
   }
@@ -138,28 +182,32 @@ class Loader {
     IdentificationParams& id = cfg.identification;
     IsolationParams& is = cfg.isolation;
 
-    auto num = [this](double* out) {
-      return [this, out](const YAML::Node& n, const std::string& p) { *out = number(n, p); };
+    // Each number gets the range within which the engine still detects (checked after the
+    // engine's own validate(), whose messages explain the finer rules).
+    auto num = [this](double* out, Range r) {
+      return [this, out, r](const YAML::Node& n, const std::string& p) { *out = number(n, p, r); };
     };
-    auto integ = [this](int* out) {
-      return [this, out](const YAML::Node& n, const std::string& p) { *out = integer(n, p); };
+    auto integ = [this](int* out, Range r) {
+      return [this, out, r](const YAML::Node& n, const std::string& p) { *out = integer(n, p, r); };
     };
     auto boo = [this](bool* out) {
       return [this, out](const YAML::Node& n, const std::string& p) { *out = boolean(n, p); };
     };
-    auto vec2 = [this](Vec2* out) {
-      return [this, out](const YAML::Node& n, const std::string& p) { *out = vector<2>(n, p); };
+    auto vec2 = [this](Vec2* out, Range r) {
+      return
+          [this, out, r](const YAML::Node& n, const std::string& p) { *out = vector<2>(n, p, r); };
     };
+    constexpr double kHour = 3600.0;
 
     const std::map<std::string, Handler> model = {
         {"B",
          [&](const YAML::Node& n, const std::string& p) {
-           cfg.B = vector<2>(n, p);
+           cfg.B = vector<2>(n, p, {-1e3, 1e3, "(b1 in m/s^2, b2 in 1/s^2, per rad of rudder)"});
            have_b = true;
          }},
         {"A0",
          [&](const YAML::Node& n, const std::string& p) {
-           id.a0 = vector<4>(n, p);
+           id.a0 = vector<4>(n, p, {-1e3, 1e3, "1/s"});
            remember(n, "identification.a0");  // the name validate() uses
          }},
     };
@@ -186,74 +234,75 @@ class Loader {
              fail(n, p, "expected rudder or regressor");
            }
          }},
-        {"eps1", num(&id.eps1)},
-        {"eps2", num(&id.eps2)},
-        {"gamma", num(&id.gamma)},
+        {"eps1", num(&id.eps1, {1e-3, 1e3, "1/s"})},
+        {"eps2", num(&id.eps2, {1e-3, 1e3, "1/s"})},
+        {"gamma", num(&id.gamma, {0, 1e15, "1/s (paper law: 1/(psi^2 s))"})},
         {"normalised", boo(&id.normalised)},
-        {"mu", num(&id.mu)},
-        {"lambda", num(&id.lambda)},
-        {"warmup_time", num(&id.warmup_time)},
-        {"max_gap", num(&id.max_gap)},
+        {"mu", num(&id.mu, {0, 1e3, "excitation^2"})},
+        {"lambda", num(&id.lambda, {0, 10, "1/s"})},
+        {"warmup_time", num(&id.warmup_time, {-1e6, kHour, "s (< 0: automatic)"})},
+        {"max_gap", num(&id.max_gap, {0, kHour, "s"})},
         {"curvature_correction", boo(&id.curvature_correction)},
         {"cubic_correction", boo(&id.cubic_correction)},
-        {"min_excitation", num(&id.min_excitation)},
-        {"settle_window", num(&id.settle_window)},
-        {"settle_tolerance", num(&id.settle_tolerance)},
-        {"settle_windows", integ(&id.settle_windows)},
-        {"settle_floor", num(&id.settle_floor)},
-        {"max_std_error", num(&id.max_std_error)},
+        {"min_excitation", num(&id.min_excitation, {0, 1, ""})},
+        {"settle_window", num(&id.settle_window, {0, kHour, "s"})},
+        {"settle_tolerance", num(&id.settle_tolerance, {0, 1, ""})},
+        {"settle_windows", integ(&id.settle_windows, {1, 1000, ""})},
+        {"settle_floor", num(&id.settle_floor, {0, 1e3, "(unit of a_n)"})},
+        {"max_std_error", num(&id.max_std_error, {0, 10, ""})},
         {"guard", boo(&id.guard)},
-        {"guard_threshold", num(&id.guard_threshold)},
-        {"guard_min_shift", num(&id.guard_min_shift)},
-        {"guard_recent_time", num(&id.guard_recent_time)},
-        {"delay", num(&cfg.identification_delay)},
+        {"guard_threshold", num(&id.guard_threshold, {0, 1e6, ""})},
+        {"guard_min_shift", num(&id.guard_min_shift, {0, 10, ""})},
+        {"guard_recent_time", num(&id.guard_recent_time, {0, 100 * kHour, "s"})},
+        {"delay", num(&cfg.identification_delay, {0, 60, "s"})},
     };
     const std::map<std::string, Handler> isolation = {
-        {"poles_v", vec2(&is.poles_v)},
-        {"poles_g", vec2(&is.poles_g)},
-        {"min_observability", num(&is.min_observability)},
-        {"redesign_tolerance", num(&is.redesign_tolerance)},
-        {"sigma_v", num(&is.sigma_v)},
-        {"sigma_r", num(&is.sigma_r)},
-        {"sigma_floor_v", num(&is.sigma_floor_v)},
-        {"sigma_floor_r", num(&is.sigma_floor_r)},
-        {"settle_time", num(&is.settle_time)},
-        {"learn_time", num(&is.learn_time)},
-        {"window", num(&is.window)},
-        {"min_window_samples", integ(&is.min_window_samples)},
-        {"clip", num(&is.clip)},
-        {"threshold", num(&is.threshold)},
-        {"threshold_margin", num(&is.threshold_margin)},
-        {"threshold_k", num(&is.threshold_k)},
-        {"exit_ratio", num(&is.exit_ratio)},
-        {"enter_time", num(&is.enter_time)},
-        {"leave_time", num(&is.leave_time)},
-        {"second_fault_time", num(&is.second_fault_time)},
-        {"min_active_time", num(&is.min_active_time)},
-        {"c_min", num(&is.c_min)},
-        {"c_margin", num(&is.c_margin)},
-        {"resume_time", num(&is.resume_time)},
-        {"resume_after_fault", num(&is.resume_after_fault)},
-        {"stale_timeout", num(&is.stale_timeout)},
-        {"stuck_time", num(&is.stuck_time)},
-        {"stuck_min_samples", integ(&is.stuck_min_samples)},
-        {"max_abs_v", num(&is.max_abs_v)},
-        {"max_abs_r", num(&is.max_abs_r)},
-        {"max_abs_delta", num(&is.max_abs_delta)},
-        {"spike_gate", num(&is.spike_gate)},
-        {"spike_window", num(&is.spike_window)},
-        {"spike_count", integ(&is.spike_count)},
-        {"invalid_count", integ(&is.invalid_count)},
-        {"classify_window", num(&is.classify_window)},
+        {"poles_v", vec2(&is.poles_v, {-1e3, 0, "1/s"})},
+        {"poles_g", vec2(&is.poles_g, {-1e3, 0, "1/s"})},
+        {"min_observability", num(&is.min_observability, {0, 1, ""})},
+        {"redesign_tolerance", num(&is.redesign_tolerance, {0, 10, ""})},
+        {"sigma_v", num(&is.sigma_v, {0, 20, "m/s"})},
+        {"sigma_r", num(&is.sigma_r, {0, 3, "rad/s"})},
+        {"sigma_floor_v", num(&is.sigma_floor_v, {0, 20, "m/s"})},
+        {"sigma_floor_r", num(&is.sigma_floor_r, {0, 3, "rad/s"})},
+        {"settle_time", num(&is.settle_time, {-1e6, kHour, "s (< 0: automatic)"})},
+        {"learn_time", num(&is.learn_time, {0, 24 * kHour, "s"})},
+        {"window", num(&is.window, {0, 600, "s"})},
+        {"min_window_samples", integ(&is.min_window_samples, {1, 1000000, ""})},
+        {"clip", num(&is.clip, {0, 1e3, ""})},
+        {"threshold",
+         num(&is.threshold, {0, 1e3, "(whitened mean square; at most 0.75 clip^2 takes effect)"})},
+        {"threshold_margin", num(&is.threshold_margin, {0, 100, ""})},
+        {"threshold_k", num(&is.threshold_k, {0, 1e3, ""})},
+        {"exit_ratio", num(&is.exit_ratio, {0, 1, ""})},
+        {"enter_time", num(&is.enter_time, {0, 60, "s"})},
+        {"leave_time", num(&is.leave_time, {0, kHour, "s"})},
+        {"second_fault_time", num(&is.second_fault_time, {0, kHour, "s"})},
+        {"min_active_time", num(&is.min_active_time, {0, kHour, "s"})},
+        {"c_min", num(&is.c_min, {0, 1, ""})},
+        {"c_margin", num(&is.c_margin, {0, 1, ""})},
+        {"resume_time", num(&is.resume_time, {0, kHour, "s"})},
+        {"resume_after_fault", num(&is.resume_after_fault, {0, kHour, "s"})},
+        {"stale_timeout", num(&is.stale_timeout, {0, kHour, "s"})},
+        {"stuck_time", num(&is.stuck_time, {0, kHour, "s"})},
+        {"stuck_min_samples", integ(&is.stuck_min_samples, {1, 1000000, ""})},
+        {"max_abs_v", num(&is.max_abs_v, {0, 1e3, "m/s"})},
+        {"max_abs_r", num(&is.max_abs_r, {0, 100, "rad/s"})},
+        {"max_abs_delta", num(&is.max_abs_delta, {0, 6.3, "rad"})},
+        {"spike_gate", num(&is.spike_gate, {0, 1e3, ""})},
+        {"spike_window", num(&is.spike_window, {0, kHour, "s"})},
+        {"spike_count", integ(&is.spike_count, {1, 1000000, ""})},
+        {"invalid_count", integ(&is.invalid_count, {1, 1000000, ""})},
+        {"classify_window", num(&is.classify_window, {0, kHour, "s"})},
     };
     const auto sub = [this](const std::map<std::string, Handler>& h) {
       return [this, &h](const YAML::Node& n, const std::string& p) { section(n, p, h); };
     };
-    const std::map<std::string, Handler> top = {
+    std::map<std::string, Handler> top = {
         {"model", sub(model)},
         {"identification", sub(identification)},
         {"isolation", sub(isolation)},
-        // Parsed by the DDS service; accepted here as any mapping.
+        // Parsed by the DDS service (through `extra`); otherwise accepted as any mapping.
         {"service",
          [this](const YAML::Node& n, const std::string& p) {
            remember(n, p);
@@ -262,6 +311,14 @@ class Loader {
            }
          }},
     };
+    if (extra_ != nullptr) {
+      for (const auto& [key, handler] : *extra_) {
+        top[key] = [this, h = handler](const YAML::Node& n, const std::string& p) {
+          const ConfigValue::Impl impl{this, n, p};
+          h(ConfigValue(&impl));
+        };
+      }
+    }
 
     if (!root.IsDefined() || root.IsNull()) fail_missing(root, "model.B");
     section(root, "", top);
@@ -271,6 +328,11 @@ class Loader {
       cfg.validate();
     } catch (const std::invalid_argument& e) {
       throw ConfigError(locate(e.what()));
+    }
+    for (const Check& c : checks_) {
+      if (c.value < c.range.lo || c.value > c.range.hi) {
+        fail(c.node, c.path, "outside the allowed range" + c.range.text());
+      }
     }
     return cfg;
   }
@@ -301,15 +363,24 @@ class Loader {
            ")";
   }
 
+  struct Check {  ///< a number to hold to its range once validate() has passed
+    YAML::Node node;
+    std::string path;
+    double value;
+    Range range;
+  };
+  std::vector<Check> checks_;
   struct Seen {
     int line = 0;      ///< 1-based
     std::string text;  ///< the value as written
   };
   std::string file_;
+  const ConfigValue::Table* extra_ = nullptr;
   std::map<std::string, Seen> seen_;
 };
 
-EngineConfig load_node(const std::string& name, const std::function<YAML::Node()>& parse) {
+EngineConfig load_node(const std::string& name, const std::function<YAML::Node()>& parse,
+                       const ConfigValue::Table* extra = nullptr) {
   YAML::Node root;
   try {
     root = parse();
@@ -323,7 +394,7 @@ EngineConfig load_node(const std::string& name, const std::function<YAML::Node()
     throw ConfigError(name + ": " + e.what());
   }
   try {
-    return Loader(name).load(root);
+    return Loader(name, extra).load(root);
   } catch (const ConfigError&) {
     throw;
   } catch (const YAML::Exception& e) {  // defensive: a yaml-cpp surprise still names the file
@@ -331,21 +402,133 @@ EngineConfig load_node(const std::string& name, const std::function<YAML::Node()
   }
 }
 
-}  // namespace
+/// The one document of a YAML text (a second one is an error: it would be ignored).
+YAML::Node single_document(const std::string& yaml, const std::string& name) {
+  std::vector<YAML::Node> docs = YAML::LoadAll(yaml);
+  if (docs.size() > 1) {
+    std::string where = name;
+    if (docs[1].Mark().line >= 0) where += ":" + std::to_string(docs[1].Mark().line + 1);
+    throw ConfigError(where + ": a second YAML document (after '---'): one file holds one " +
+                      "configuration");
+  }
+  return docs.empty() ? YAML::Node() : docs[0];
+}
 
-EngineConfig load_engine_config(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw ConfigError(path + ": no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) throw ConfigError(path + ": not a regular file");
+std::string read_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    throw ConfigError(path + ": cannot read: " + std::strerror(errno));
+  }
+  if (!S_ISREG(st.st_mode)) throw ConfigError(path + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot open for reading: " + std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
-  return load_engine_config_from_string(text.str(), path);
+  if (in.bad()) throw ConfigError(path + ": read error: " + std::strerror(errno));
+  return text.str();
+}
+
+/// A value as the service's messages show it: the scalar as written, <list>, <mapping>.
+std::string plain(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "null";
+  if (n.IsScalar()) return n.Scalar();
+  return n.IsSequence() ? "<list>" : "<mapping>";
+}
+
+}  // namespace
+
+const std::string& ConfigValue::path() const { return impl_->path; }
+
+bool ConfigValue::is_null() const { return !impl_->node.IsDefined() || impl_->node.IsNull(); }
+
+std::string ConfigValue::where() const {
+  const YAML::Node& n = impl_->node;
+  std::string w = impl_->loader->file();
+  if (n.IsDefined() && n.Mark().line >= 0) w += ":" + std::to_string(n.Mark().line + 1);
+  return w + ": " + impl_->path + " = " + plain(n);
+}
+
+void ConfigValue::fail(const std::string& reason) const {
+  throw ConfigError(where() + ": " + reason);
+}
+
+double ConfigValue::number(double lo, double hi, const std::string& what,
+                           const std::string& range) const {
+  double x = 0.0;
+  if (!impl_->node.IsScalar() || !YAML::convert<double>::decode(impl_->node, x) ||
+      !std::isfinite(x)) {
+    fail("must be " + what);
+  }
+  if (x < lo || x > hi) fail("must be " + (range.empty() ? what : range));
+  return x;
+}
+
+long long ConfigValue::integer(long long lo, long long hi, const std::string& what,
+                               const std::string& range) const {
+  long long x = 0;
+  if (!impl_->node.IsScalar() || !YAML::convert<long long>::decode(impl_->node, x)) {
+    fail("must be " + what);
+  }
+  if (x < lo || x > hi) fail("must be " + (range.empty() ? what : range));
+  return x;
+}
+
+bool ConfigValue::boolean() const {
+  bool x = false;
+  if (!impl_->node.IsScalar() || !YAML::convert<bool>::decode(impl_->node, x)) {
+    fail("must be true or false");
+  }
+  return x;
+}
+
+std::string ConfigValue::text(const std::string& what) const {
+  if (!impl_->node.IsScalar()) fail("must be " + what);
+  return impl_->node.Scalar();
+}
+
+std::vector<std::string> ConfigValue::strings() const {
+  if (!impl_->node.IsSequence()) fail("must be a list of strings");
+  std::vector<std::string> out;
+  for (const YAML::Node& e : impl_->node) {
+    const Impl item{impl_->loader, e, impl_->path};
+    out.push_back(ConfigValue(&item).text("a string"));
+  }
+  return out;
+}
+
+void ConfigValue::section(const Table& table, const std::string& unknown, bool show_key) const {
+  if (is_null()) return;
+  if (!impl_->node.IsMap()) fail("must be a mapping");
+  std::set<std::string> keys;
+  for (const auto& kv : impl_->node) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : plain(kv.first);
+    const Impl item{impl_->loader, kv.second, impl_->path + "." + key};
+    const ConfigValue value(&item);
+    if (!keys.insert(key).second) value.fail("key given twice");
+    const auto it = table.find(key);
+    if (it == table.end()) {
+      std::string allowed;
+      for (const auto& h : table) allowed += (allowed.empty() ? "" : ", ") + h.first;
+      const Impl name{impl_->loader, show_key ? kv.first : kv.second, item.path};
+      ConfigValue(&name).fail(unknown + " (expected one of: " + allowed + ")");
+    }
+    it->second(value);
+  }
+}
+
+EngineConfig load_engine_config(const std::string& path, const ConfigValue::Table& extra) {
+  const std::string text = read_file(path);
+  return load_node(
+      path, [&] { return single_document(text, path); }, &extra);
+}
+
+EngineConfig load_engine_config(const std::string& path) {
+  const std::string text = read_file(path);
+  return load_engine_config_from_string(text, path);
 }
 
 EngineConfig load_engine_config_from_string(const std::string& yaml, const std::string& name) {
-  return load_node(name, [&yaml] { return YAML::Load(yaml); });
+  return load_node(name, [&] { return single_document(yaml, name); });
 }
 
 }  // namespace usvfdi::io

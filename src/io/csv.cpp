@@ -1,14 +1,16 @@
 #include "usv_fdi/io/csv.hpp"
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <istream>
 #include <ostream>
+#include <set>
 #include <utility>
 
 namespace usvfdi::io {
@@ -82,10 +84,12 @@ bool parse_csv_number(const std::string& field, double* out) {
 }
 
 CsvSampleReader::CsvSampleReader(const std::string& path) : name_(path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, 0, "", "", "no such file");
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError(path, 0, "", "", "is a directory");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    throw InputError(path, 0, "", "", std::string("cannot read: ") + std::strerror(errno));
+  }
+  if (S_ISDIR(st.st_mode)) {
+    throw InputError(path, 0, "", "", std::string("cannot read: ") + std::strerror(EISDIR));
   }
   auto f = std::make_unique<std::ifstream>(path, std::ios::binary);
   if (!*f) {
@@ -103,15 +107,44 @@ CsvSampleReader::CsvSampleReader(std::unique_ptr<std::istream> in, const std::st
 CsvSampleReader::~CsvSampleReader() = default;
 
 bool CsvSampleReader::next_line(std::string* text) {
-  while (std::getline(*in_, *text)) {
+  if (buffer_.empty()) buffer_.resize(kCsvMaxLine + 2);
+  while (true) {
+    // At most kCsvMaxLine + 1 bytes (the + 1 tells a line that is too long), so that a file
+    // without line ends cannot take the memory.
+    in_->getline(buffer_.data(), static_cast<std::streamsize>(kCsvMaxLine + 2));
+    const std::size_t got = static_cast<std::size_t>(in_->gcount());
+    if (got == 0 && in_->fail()) break;  // end of file
     ++line_;
+    if (in_->fail() && !in_->eof()) {
+      throw InputError(name_, line_, "", "",
+                       "line longer than " + std::to_string(kCsvMaxLine) +
+                           " bytes (the limit; is this a CSV file with line ends?)");
+    }
+    // gcount includes the '\n' when there was one (not at the end of the file).
+    text->assign(buffer_.data(), in_->eof() ? got : got - 1);
+    if (in_->eof()) in_->clear(std::ios::eofbit);
+    if (text->size() > kCsvMaxLine) {
+      throw InputError(name_, line_, "", "",
+                       "line longer than " + std::to_string(kCsvMaxLine) + " bytes (the limit)");
+    }
     if (!text->empty() && text->back() == '\r') text->pop_back();
     if (line_ == 1 && text->compare(0, 3, "\xEF\xBB\xBF") == 0) text->erase(0, 3);
+    if (text->find('\0') != std::string::npos) {
+      throw InputError(name_, line_, "", "",
+                       "NUL byte in the line (a binary or UTF-16 file? expected ASCII/UTF-8 text)");
+    }
+    if (text->find('\r') != std::string::npos) {
+      throw InputError(name_, line_, "", "",
+                       "carriage return inside a line: the file has CR-only line ends (convert "
+                       "them to LF or CRLF)");
+    }
     const std::string t = trim(*text);
     if (t.empty() || t[0] == '#') continue;
     return true;
   }
-  if (in_->bad()) throw InputError(name_, line_ + 1, "", "", "read error");
+  if (in_->bad()) {
+    throw InputError(name_, line_ + 1, "", "", std::string("read error: ") + std::strerror(errno));
+  }
   return false;
 }
 
@@ -121,12 +154,16 @@ void CsvSampleReader::read_header() {
     throw InputError(name_, 0, "", "", "empty file (expected a header line naming t,v,r,delta)");
   }
   split(text, &header_);
+  if (header_.size() > kCsvMaxColumns) {
+    throw InputError(name_, line_, "", "",
+                     "the header has " + std::to_string(header_.size()) + " columns (at most " +
+                         std::to_string(kCsvMaxColumns) + ")");
+  }
   for (std::string& h : header_) h = trim(h);
+  std::set<std::string> names;
   for (std::size_t i = 0; i < header_.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (header_[i] == header_[j] && !header_[i].empty()) {
-        throw InputError(name_, line_, header_[i], text, "column named twice in the header");
-      }
+    if (!header_[i].empty() && !names.insert(header_[i]).second) {
+      throw InputError(name_, line_, header_[i], text, "column named twice in the header");
     }
     for (int k = 0; k < 4; ++k) {
       if (header_[i] == kRequired[k]) col_[k] = static_cast<int>(i);

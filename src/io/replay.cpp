@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "usv_fdi/io/plausibility.hpp"
+
 namespace usvfdi::io {
 
 RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& out,
@@ -13,6 +15,7 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
   std::vector<FaultEvent> events;
   double first_t = kNaN, last_t = kNaN, last_record = kNaN;
   bool last_converged = false, last_armed = false;
+  PlausibilityCheck plausible;
   FaultState latched[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};
 
   const auto emit = [&](const FaultEvent& e) {
@@ -33,14 +36,25 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
     sum.converged = engine.estimate().converged;
     sum.frozen_samples = engine.frozen_samples();
     sum.duration_s = std::isnan(first_t) ? 0.0 : last_t - first_t;
+    sum.warnings = plausible.warnings();
+    sum.not_converged = convergence_report(engine.estimate(), cfg.identification);
   };
 
   Sample s;
   try {
     while (input.next(&s)) {
       ++sum.samples;
+      plausible.add(s);
       events.clear();
-      if (!engine.process(s, &events)) ++sum.rejected;
+      if (!engine.process(s, &events)) {
+        ++sum.rejected;
+        if (!std::isfinite(s.t)) ++sum.rejected_no_time;
+        if (sum.first_rejected_line == 0) {
+          sum.first_rejected_line = input.line();
+          sum.first_rejected_t = s.t;
+          sum.first_rejected_after = last_t;
+        }
+      }
       for (const FaultEvent& e : events) {
         emit(e);
         if (options.auto_ack &&

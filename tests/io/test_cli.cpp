@@ -1,11 +1,17 @@
 // End-to-end tests of the usv-fdi executable: sim -> CSV -> replay -> JSON Lines, exit
 // codes and messages on bad input.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,10 +56,16 @@ class Cli : public ::testing::Test {
 
   std::string path(const std::string& name) const { return dir_ + name; }
 
-  Outcome run(const std::string& args) const {
+  /// Runs `usv-fdi ARGS`, after the shell commands `prefix` (e.g. "ulimit -f 4; ").
+  Outcome run(const std::string& args, const std::string& prefix = "") const {
+    return shell(prefix + "'" + kExe + "' " + args);
+  }
+
+  /// Runs shell commands, collecting their exit code, stdout and stderr.
+  Outcome shell(const std::string& commands) const {
     Outcome r;
     const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const std::string cmd = "'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'";
+    const std::string cmd = "{ " + commands + "; } >'" + out + "' 2>'" + err + "'";
     const int status = std::system(cmd.c_str());
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp(out);
@@ -178,6 +190,168 @@ TEST_F(Cli, InputErrorsExitWith3AndKeepTheRecordsBefore) {
   EXPECT_FALSE(recs.back().at("complete").b);
   EXPECT_EQ(recs.back().at("samples").num, 201.0);
   EXPECT_TRUE(has(recs.back().at("error").str, "bad.csv:203"));
+}
+
+TEST_F(Cli, ReplayRefusesAnOutputThatIsItsInputOrConfig) {
+  const std::string csv = small_csv();
+  const std::string recording = slurp(csv);
+  spit(path("cfg.yaml"), slurp(kSource + "/config/vessels/otter.yaml"));
+  const std::string cfg = path("cfg.yaml");
+  const std::string settings = slurp(cfg);
+  ASSERT_EQ(::symlink(csv.c_str(), path("link.csv").c_str()), 0);
+  ASSERT_EQ(::link(csv.c_str(), path("hard.csv").c_str()), 0);
+  ASSERT_EQ(::symlink(cfg.c_str(), path("link.yaml").c_str()), 0);
+  ASSERT_EQ(std::system(("mkdir -p '" + path("sub") + "'").c_str()), 0);
+  for (const std::string& out : {csv, cfg, path("link.csv"), path("hard.csv"), path("link.yaml"),
+                                 path("sub/../small.csv")}) {
+    const Outcome r =
+        run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + out + "'");
+    EXPECT_EQ(r.code, 4) << out << ": " << r.err;
+    EXPECT_TRUE(has(r.err, "same file")) << r.err;
+    EXPECT_TRUE(has(r.err, out)) << r.err;
+    EXPECT_TRUE(slurp(csv) == recording) << out << ": the recording was changed";
+    EXPECT_TRUE(slurp(cfg) == settings) << out << ": the configuration was changed";
+  }
+  // stdout redirected onto the recording (append, so that the shell does not truncate it)
+  const Outcome r =
+      run("replay --config '" + cfg + "' --input '" + csv + "' --output - >>'" + csv + "'");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(slurp(csv) == recording) << "the recording was changed";
+}
+
+TEST_F(Cli, ReplayThatFailsToWriteLeavesTheExistingOutputUntouched) {
+  const std::string csv = small_csv();
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  const std::string jsonl = path("out.jsonl");
+  spit(jsonl, "the previous run's output\n");
+  // A 4 KiB file-size limit (SIGXFSZ ignored, so write(2) fails with EFBIG) stops the replay
+  // part-way through its output.
+  const Outcome r =
+      run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + jsonl + "'",
+          "trap '' XFSZ; ulimit -f 4; ");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, jsonl)) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(EFBIG))) << r.err;
+  EXPECT_EQ(slurp(jsonl), "the previous run's output\n");
+  // no temporary file is left behind
+  const Outcome ls =
+      shell("ls -A '" + dir_ +
+            "' | grep -v -x -e small.csv -e out.jsonl -e stdout.txt -e stderr.txt || true");
+  EXPECT_EQ(ls.out, "");
+
+  // A successful run replaces it, through a symlink the link stays and its target changes.
+  ASSERT_EQ(::symlink(jsonl.c_str(), path("link.jsonl").c_str()), 0);
+  const Outcome ok = run("replay --config '" + cfg + "' --input '" + csv + "' --output '" +
+                         path("link.jsonl") + "'");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(parse_lines(slurp(jsonl)).back().at("type").str, "summary");
+  struct stat st {};
+  ASSERT_EQ(::lstat(path("link.jsonl").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode));
+}
+
+/// The CSV text with the time field of data rows [first, last] (1-based, header excluded)
+/// replaced by `t`, and the rows in `repeat` written twice.
+std::string with_times(const std::string& csv, int first, int last, const std::string& t,
+                       const std::set<int>& repeat = {}) {
+  std::istringstream in(csv);
+  std::string line, out;
+  std::getline(in, line);
+  out = line + "\n";
+  for (int row = 1; std::getline(in, line); ++row) {
+    if (row >= first && row <= last) line = t + line.substr(line.find(','));
+    out += line + "\n";
+    if (repeat.count(row)) out += line + "\n";
+  }
+  return out;
+}
+
+TEST_F(Cli, ReplayOfMostlyRejectedRowsExitsWith5) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  const std::string csv = slurp(small_csv());  // 301 rows, t = 0 .. 30 s
+  // The INS clock sticks at 5 s from row 52 on: 250 rows do not advance.
+  spit(path("stuck.csv"), with_times(csv, 52, 301, "5"));
+  const std::string jsonl = path("stuck.jsonl");
+  Outcome r = run("replay --config '" + cfg + "' --input '" + path("stuck.csv") + "' --output '" +
+                  jsonl + "'");
+  EXPECT_EQ(r.code, 5) << r.err;
+  EXPECT_TRUE(has(r.err, "250 of 301 rows")) << r.err;
+  EXPECT_TRUE(has(r.err, "stuck.csv:53")) << r.err;  // the first rejected row's line
+  EXPECT_TRUE(has(r.err, "error")) << r.err;
+  const auto recs = parse_lines(slurp(jsonl));  // the records are still written
+  ASSERT_FALSE(recs.empty());
+  EXPECT_EQ(recs.back().at("rejected").num, 250.0);
+
+  // Three repeated rows: a warning, exit 0.
+  spit(path("dup.csv"), with_times(csv, 0, 0, "", {100, 200, 250}));
+  r = run("replay --config '" + cfg + "' --input '" + path("dup.csv") + "' --output '" + jsonl +
+          "'");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(has(r.err, "warn")) << r.err;
+  EXPECT_TRUE(has(r.err, "3 of 304 rows")) << r.err;
+  EXPECT_TRUE(has(r.err, "dup.csv:102")) << r.err;
+}
+
+TEST_F(Cli, ReplayWarnsOfUnitMistakesAndSaysWhyItDidNotConverge) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  std::istringstream in(slurp(small_csv()));  // 30 s at 10 Hz
+  std::string line, ms, deg, empty;
+  std::getline(in, line);
+  ms = deg = empty = line + "\n";
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    f.resize(11);
+    const auto row = [&f] {
+      std::string s;
+      for (const std::string& x : f) s += (s.empty() ? "" : ",") + x;
+      return s + "\n";
+    };
+    const std::string t = f[0], delta = f[3];
+    f[0] = std::to_string(std::stod(t) * 1000.0);
+    ms += row();
+    f[0] = t;
+    f[3] = std::to_string(std::stod(delta) * 180.0 / M_PI);
+    deg += row();
+    f[3] = "";
+    empty += row();
+  }
+  const std::pair<const char*, const std::string*> cases[] = {
+      {"probably in milliseconds", &ms}, {"probably in degrees", &deg}, {"no value", &empty}};
+  for (const auto& [expect, text] : cases) {
+    spit(path("in.csv"), *text);
+    const Outcome r = run("replay --config '" + cfg + "' --input '" + path("in.csv") +
+                          "' --output '" + path("out.jsonl") + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(has(r.err, "warning: " + path("in.csv") + ": column")) << r.err;
+    EXPECT_TRUE(has(r.err, expect)) << r.err;
+    EXPECT_TRUE(has(r.err, "has not converged")) << r.err;
+  }
+}
+
+TEST_F(Cli, FileErrorsGiveTheSystemsReason) {
+  const std::string cfg = kSource + "/config/vessels/otter.yaml";
+  const std::string nowhere = path("no/such/dir/out.csv");
+  Outcome r = run("sim --vessel otter --duration 5 --output '" + nowhere + "'");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, nowhere)) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+  // sim's output cut short by a 4 KiB file-size limit
+  r = run("sim --vessel otter --duration 60 --output '" + path("big.csv") + "'",
+          "trap '' XFSZ; ulimit -f 4; ");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(EFBIG))) << r.err;
+  const std::string csv = small_csv();
+  r = run("replay --config '" + cfg + "' --input '" + csv + "' --output '" + nowhere + "'");
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+  r = run("replay --config '" + path("none.yaml") + "' --input '" + csv + "'");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
+  r = run("replay --config '" + cfg + "' --input '" + path("none.csv") + "'");
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_TRUE(has(r.err, std::strerror(ENOENT))) << r.err;
 }
 
 TEST_F(Cli, SimFaultsAndOptions) {

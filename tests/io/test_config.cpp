@@ -264,6 +264,36 @@ TEST(ConfigError, ValidateFailureIsRethrownWithFileKeyLineAndValue) {
   EXPECT_MENTIONS(a, "cfg_test.yaml:3", "model.A0", ".nan");
 }
 
+TEST(ConfigError, ValuesThatSwitchDetectionOffAreRefusedWithTheirRange) {
+  const std::string d = error_of("model:\n  B: [1, 2]\nidentification:\n  delay: 1e9\n");
+  EXPECT_MENTIONS(d, "cfg_test.yaml:4", "identification.delay", "1e9", "allowed range",
+                  "[0, 60] s");
+  const std::string t = error_of("model:\n  B: [1, 2]\nisolation:\n  threshold: .inf\n");
+  EXPECT_MENTIONS(t, "cfg_test.yaml:4", "isolation.threshold", ".inf", "finite", "[0, 1000]");
+  const std::string b = error_of("model:\n  B: [1e300, -2]\n");
+  EXPECT_MENTIONS(b, "cfg_test.yaml:2", "model.B[0]", "1e300", "[-1000, 1000]");
+  const std::string n = error_of("model:\n  B: [1, 2]\nisolation:\n  window: .nan\n");
+  EXPECT_MENTIONS(n, "cfg_test.yaml:4", "isolation.window", "finite");
+  const std::string c = error_of("model:\n  B: [1, 2]\nisolation:\n  spike_count: 100000000\n");
+  EXPECT_MENTIONS(c, "cfg_test.yaml:4", "isolation.spike_count", "[1, 1e+06]");
+  // the engine's own rules keep their messages
+  const std::string e = error_of("model:\n  B: [1, 2]\nidentification:\n  eps1: -3\n");
+  EXPECT_MENTIONS(e, "positive");
+}
+
+TEST(ConfigError, ShippedConfigsAreWithinTheRanges) {
+  for (const char* f : {"default.yaml", "paper.yaml", "vessels/otter.yaml", "vessels/mariner.yaml",
+                        "scenarios/paper.yaml", "service/example.yaml"}) {
+    EXPECT_NO_THROW(load_engine_config(kSource + "/config/" + f)) << f;
+  }
+}
+
+TEST(ConfigError, ASecondDocumentIsRefused) {
+  const std::string m = error_of("model:\n  B: [1, 2]\n---\nmodel:\n  B: [3, 4]\n");
+  EXPECT_MENTIONS(m, "cfg_test.yaml:", "second YAML document");
+  EXPECT_NO_THROW(load_engine_config_from_string("---\nmodel:\n  B: [1, 2]\n...\n"));
+}
+
 TEST(ConfigError, DuplicateKey) {
   const std::string m = error_of("model:\n  B: [1, 2]\n  B: [3, 4]\n");
   EXPECT_MENTIONS(m, "cfg_test.yaml:3", "model.B", "twice");

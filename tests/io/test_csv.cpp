@@ -1,6 +1,7 @@
 // CSV reader and writer.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -118,6 +119,56 @@ TEST(CsvError, EmptyFileAndMissingFile) {
 TEST(CsvError, DuplicateColumn) {
   const InputError e = error_of("t,v,r,delta,v\n0,0,0,0,0\n");
   EXPECT_EQ(e.column(), "v");
+}
+
+TEST(CsvError, NulByteIsRefused) {
+  const InputError e = error_of(std::string("t,v,r,delta\n0,0,0,0\n0.1,0\0,0,0\n", 31));
+  EXPECT_EQ(e.line(), 3u);
+  EXPECT_TRUE(contains(e.what(), "NUL byte")) << e.what();
+  EXPECT_TRUE(contains(e.what(), "in_test.csv:3")) << e.what();
+}
+
+TEST(CsvError, CrOnlyLineEndsAreNamed) {
+  const InputError e = error_of("t,v,r,delta\r0,0,0,0\r0.1,0,0,0\r");
+  EXPECT_TRUE(contains(e.what(), "CR")) << e.what();
+  EXPECT_FALSE(contains(e.what(), "named twice")) << e.what();
+}
+
+TEST(CsvError, HugeHeaderAndHugeLineAreRefusedQuickly) {
+  // 100 000 columns (0.9 MB) in the header
+  std::string header = "t,v,r,delta";
+  for (int i = 0; i < 100000; ++i) header += ",c" + std::to_string(i);
+  const auto start = std::chrono::steady_clock::now();
+  InputError e = error_of(header + "\n0,0,0,0\n");
+  EXPECT_EQ(e.line(), 1u);
+  EXPECT_TRUE(contains(e.what(), "longer than")) << e.what();
+  // 2000 short columns: within the line limit, beyond the column limit
+  std::string wide = "t,v,r,delta";
+  for (int i = 0; i < 2000; ++i) wide += ",c" + std::to_string(i);
+  e = error_of(wide + "\n");
+  EXPECT_TRUE(contains(e.what(), "2004 columns")) << e.what();
+  EXPECT_TRUE(contains(e.what(), std::to_string(kCsvMaxColumns))) << e.what();
+  // a 32 MB data line (the 300 MB of the issue behave the same): refused after reading
+  // kCsvMaxLine bytes of it
+  std::string big = "t,v,r,delta\n0,0,0,0\n";
+  big.append(32u << 20, '1');
+  e = error_of(big);
+  EXPECT_EQ(e.line(), 3u);
+  EXPECT_TRUE(contains(e.what(), "line longer than " + std::to_string(kCsvMaxLine))) << e.what();
+  // a busy machine may be slow, but not by the 22 s of the quadratic header check
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
+}
+
+TEST(Csv, LinesUpToTheLimitAreRead) {
+  std::string text = "t,v,r,delta\n0,0,0,0\n0.1,0,0,";
+  text.append(kCsvMaxLine - 9, ' ');  // exactly kCsvMaxLine bytes
+  text += "0\n";
+  auto r = reader(text);
+  Sample s;
+  EXPECT_TRUE(r->next(&s));
+  EXPECT_TRUE(r->next(&s));
+  EXPECT_EQ(s.t, 0.1);
+  EXPECT_FALSE(r->next(&s));
 }
 
 TEST(Csv, SimulatorRowsRoundTripBitForBit) {

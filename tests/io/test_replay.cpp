@@ -232,5 +232,24 @@ TEST(Scenarios, FaultSpecParsesAndRejects) {
   }
 }
 
+TEST(Replay, CountsAndLocatesRejectedRows) {
+  const std::string csv =
+      "t,v,r,delta\n"
+      "0,0,0,0\n"
+      "0.1,0,0,0\n"
+      "0.1,0,0,0\n"   // line 4: repeats
+      "nan,0,0,0\n"   // line 5: no time
+      "0.05,0,0,0\n"  // line 6: goes back
+      "0.2,0,0,0\n";
+  RunSummary sum;
+  replay_text(quick_config(), csv, &sum);
+  EXPECT_EQ(sum.samples, 6u);
+  EXPECT_EQ(sum.rejected, 3u);
+  EXPECT_EQ(sum.rejected_no_time, 1u);
+  EXPECT_EQ(sum.first_rejected_line, 4u);
+  EXPECT_EQ(sum.first_rejected_t, 0.1);
+  EXPECT_EQ(sum.first_rejected_after, 0.1);
+}
+
 }  // namespace
 }  // namespace usvfdi::io

@@ -114,6 +114,11 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
       {"  log_level: loud", "4: service.log_level = loud: must be one of"},
       {"  partitions: fleet", "4: service.partitions = fleet: must be a list"},
       {"  topics: {ins: a, radar: b}", "4: service.topics.radar = b: unknown topic"},
+      {"  topics: {ins: a, status: a}",
+       "4: service.topics.status = a: the same topic name as service.topics.ins"},
+      {"  topics: {fault_ack: usv_fdi/status}",
+       "4: service.topics.fault_ack = usv_fdi/status: the same topic name as "
+       "service.topics.status"},
       {"  input_queue: 0", "4: service.input_queue = 0: must be 1..1000000"},
       {"  rudder_wait: -1", "4: service.rudder_wait = -1: must be a positive time"},
       {"  reliable_inputs: maybe", "4: service.reliable_inputs = maybe: must be true or false"},

@@ -187,7 +187,7 @@ TEST_P(DremProperty, EachEstimateConvergesMonotonically) {
     // Allowed growth per sample: the sampled identity h = psi a holds to ~1e-7 relative
     // (O(h^3) of the first-order hold with curvature) and each step can move a^_n at most by
     // that much toward a wrong target. The paper's R = [q; q_bar] is ill conditioned near
-    // the zero crossings of psi (DESIGN.md section 2, finding 2), which amplifies it ~1e3x.
+    // the zero crossings of psi (docs/design.md section 2, finding 2), which amplifies it ~1e3x.
     const double slack = (is_paper(GetParam()) ? 2e-3 : 1e-6) * a.norm();
     for (const Sample& s : d.samples) {
       // WHEN each sample is fed

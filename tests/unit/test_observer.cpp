@@ -1,4 +1,4 @@
-// Property tests of the dedicated observers (DESIGN.md section 3): pole placement, exact
+// Property tests of the dedicated observers (docs/design.md section 3): pole placement, exact
 // discretisation, the discrete Lyapunov solver, and the structured-residual directions.
 #include <gtest/gtest.h>
 

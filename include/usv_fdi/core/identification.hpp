@@ -1,6 +1,6 @@
 // Identification of the unknown sway-yaw matrix A by DREM (dynamic regressor extension
 // and mixing), Bazylev & Margun section 3, with the better-conditioned variant of
-// DESIGN.md section 2 (normalised update, Kreisselmeier regressor extension).
+// docs/design.md section 2 (normalised update, Kreisselmeier regressor extension).
 //
 //   q = F1[y],  m = p F1[y] - B F1[delta] = eps1 (y - q) - B F1[delta]   =>  m = A q
 //   paper:        R = [[q1 q2], [qb1 qb2]] (second filter eps2), G1 = [m1 mb1]^T, G2 = [m2 mb2]^T,

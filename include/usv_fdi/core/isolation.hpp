@@ -1,4 +1,4 @@
-// Detection and isolation (the isolation thread's engine), DESIGN.md sections 3 and 4.
+// Detection and isolation (the isolation thread's engine), docs/design.md sections 3 and 4.
 //
 // Two dedicated observers on the current estimate of A give the structured residual
 //   s = [ (y1 - x1^V) / sigma_sa , (y2 - x2^G) / sigma_sg ]

@@ -1,4 +1,4 @@
-// Dedicated Luenberger observers of DESIGN.md section 3.
+// Dedicated Luenberger observers of docs/design.md section 3.
 //
 // Observer V is driven by the accelerometer channel alone (K = [k_V 0], needs a2 != 0),
 // observer G by the gyro alone (K = [0 k_G], needs a3 != 0). Gains by pole placement on

@@ -1,6 +1,6 @@
 // Vessel simulator: Nomoto sway-yaw model with a heading autopilot (so that course-unstable
 // vessels stay bounded), rudder saturation, rate limit and servo lag, sensor noise and
-// scripted INS faults of every kind of DESIGN.md section 4.
+// scripted INS faults of every kind of docs/design.md section 4.
 #pragma once
 
 #include <cstdint>

@@ -32,7 +32,7 @@ struct Sample {
 /// The INS sensor a fault is attributed to.
 enum class Sensor : std::uint8_t { kAccelerometer = 0, kGyro = 1, kUnknown = 2 };
 
-/// Fault kinds (DESIGN.md section 4); kUnknown where they cannot be told apart.
+/// Fault kinds (docs/design.md section 4); kUnknown where they cannot be told apart.
 enum class FaultKind : std::uint8_t {
   kUnknown = 0,
   kBias,

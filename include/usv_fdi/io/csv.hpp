@@ -4,6 +4,9 @@
 // columns are ignored. A field `nan`, `NaN` or empty is a missing value (NaN). Numbers are
 // parsed with strtod (C locale) and trailing garbage is an error. Blank lines and lines
 // starting with '#' are skipped; CRLF line ends and a UTF-8 byte order mark are accepted.
+// Refused with an InputError: a NUL byte (a binary or UTF-16 file), a carriage return inside
+// a line (CR-only line ends), a line longer than kCsvMaxLine bytes (read no further than
+// that) and a header of more than kCsvMaxColumns columns.
 //
 // Output: simulator rows with %.17g, so that sim -> CSV -> replay reproduces every double
 // bit for bit (a replay of the CSV gives exactly the events of the in-memory run).
@@ -20,6 +23,11 @@
 #include "usv_fdi/core/types.hpp"
 
 namespace usvfdi::io {
+
+/// Longest line accepted [bytes] (a data row of 11 doubles at %.17g is under 300).
+constexpr std::size_t kCsvMaxLine = 65536;
+/// Most columns accepted in the header.
+constexpr std::size_t kCsvMaxColumns = 1024;
 
 /// A problem with an input file: "<file>:<line>: column '<name>': <reason>: '<text>'".
 class InputError : public std::runtime_error {
@@ -75,6 +83,7 @@ class CsvSampleReader {
   std::vector<std::string> header_;
   int col_[4] = {-1, -1, -1, -1};  ///< field index of t, v, r, delta
   std::vector<std::string> fields_;
+  std::vector<char> buffer_;  ///< kCsvMaxLine + 1 bytes for one line
 };
 
 /// Writes simulator rows: t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g

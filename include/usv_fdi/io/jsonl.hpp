@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "usv_fdi/core/engine.hpp"
 
@@ -33,15 +34,23 @@ std::string json_string_array(const std::string& names, const char* separator = 
 /// What a replay did (the summary record).
 struct RunSummary {
   std::uint64_t samples = 0;   ///< rows read
-  std::uint64_t rejected = 0;  ///< rows the engine rejected (time did not increase)
-  std::uint64_t events = 0;    ///< event records written
+  std::uint64_t rejected = 0;  ///< rows the engine rejected (time missing or not increasing)
+  std::uint64_t rejected_no_time = 0;  ///< of them: time missing or not finite
+  // The first rejected row (not in the JSON record; for the command's message).
+  std::size_t first_rejected_line = 0;           ///< its line in the input (0: none rejected)
+  double first_rejected_t = kNaN;                ///< its time [s]
+  double first_rejected_after = kNaN;            ///< the latest time accepted before it [s]
+  std::uint64_t events = 0;                      ///< event records written
   std::array<std::uint64_t, 3> raised{0, 0, 0};  ///< raised events per Sensor
   Vec4 final_a = Vec4::Zero();
   bool converged = false;
   std::uint64_t frozen_samples = 0;
   double duration_s = 0.0;  ///< last minus first sample time [s, data time]
   bool complete = true;     ///< false: the input ended in an error
-  std::string error;        ///< that error (only when !complete)
+  // For the command's messages, not in the JSON record:
+  std::vector<std::string> warnings;  ///< PlausibilityCheck's findings on the input
+  std::string not_converged;          ///< convergence_report() at the end ("" if converged)
+  std::string error;                  ///< that error (only when !complete)
 };
 
 class JsonlWriter {

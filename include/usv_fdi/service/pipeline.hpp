@@ -1,4 +1,4 @@
-// The service's threads, without the middleware (DESIGN.md section 6):
+// The service's threads, without the middleware (docs/design.md section 6):
 //   listeners -> input queue -> isolation thread (assembles samples, observers, decision,
 //   latch, acks) -> identification queue -> identification thread (DREM, publishes estimate
 //   snapshots back to the isolation thread) ; isolation thread -> output queue -> publisher
