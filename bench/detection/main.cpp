@@ -19,8 +19,9 @@
 
 int main(int argc, char** argv) {
   using namespace usvfdi::bench;
-  CLI::App app{"usv-fdi detection benchmark: engine, the paper's method and an oracle on the "
-               "vessel zoo and the HSVA KVLCC2 tests"};
+  CLI::App app{
+      "usv-fdi detection benchmark: engine, the paper's method and an oracle on the "
+      "vessel zoo and the HSVA KVLCC2 tests"};
   BenchOptions opt;
   opt.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::string json_file, md_file;
@@ -28,7 +29,8 @@ int main(int argc, char** argv) {
   bool no_realdata = false, no_progress = false;
   std::string realdata;
   app.add_flag("--quick", opt.quick, "the CI mode (a few minutes on 2 cores)");
-  app.add_option("--jobs,-j", opt.jobs, "worker threads")->check(CLI::Range(1, 256))
+  app.add_option("--jobs,-j", opt.jobs, "worker threads")
+      ->check(CLI::Range(1, 256))
       ->capture_default_str();
   app.add_option("--seeds", opt.seeds, "seeds per configuration (default: the mode's)")
       ->check(CLI::Range(1, 1000));
@@ -47,8 +49,8 @@ int main(int argc, char** argv) {
 
   try {
     if (!no_realdata) {
-      opt.realdata_dir = realdata.empty() ? find_realdata(USV_FDI_SOURCE_DIR, &opt.realdata_note)
-                                          : realdata;
+      opt.realdata_dir =
+          realdata.empty() ? find_realdata(USV_FDI_SOURCE_DIR, &opt.realdata_note) : realdata;
       if (opt.realdata_dir.empty()) std::fprintf(stderr, "note: %s\n", opt.realdata_note.c_str());
     }
     usvfdi::EngineConfig engine_cfg, paper_cfg;
@@ -56,7 +58,8 @@ int main(int argc, char** argv) {
     const std::vector<Case> cases = make_cases(opt);
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<CaseResult> results = run_all(cases, opt, engine_cfg, paper_cfg);
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const auto tables = summarise(cases, results);
 
     std::string command = "usv-fdi-bench-detection";
@@ -65,11 +68,12 @@ int main(int argc, char** argv) {
     const std::time_t now = std::time(nullptr);
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
     char head[512];
-    std::snprintf(head, sizeof head,
-                  "`%s` (%s mode), %s, %zu runs in %.0f s on %d thread(s).%s%s", command.c_str(),
-                  opt.quick ? "quick" : "full", date, cases.size(), secs, opt.jobs,
+    std::snprintf(head, sizeof head, "`%s` (%s mode), %s, %zu runs in %.0f s on %d thread(s).%s%s",
+                  command.c_str(), opt.quick ? "quick" : "full", date, cases.size(), secs, opt.jobs,
                   opt.realdata_dir.empty() ? " Real data left out: " : "",
-                  opt.realdata_dir.empty() ? (no_realdata ? "--no-realdata" : opt.realdata_note.c_str()) : "");
+                  opt.realdata_dir.empty()
+                      ? (no_realdata ? "--no-realdata" : opt.realdata_note.c_str())
+                      : "");
     const std::string md = to_markdown(tables, head);
     std::cout << md;
     if (!md_file.empty()) {

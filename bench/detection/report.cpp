@@ -55,16 +55,19 @@ std::string to_markdown(const std::vector<TableSummary>& tables, const std::stri
   for (const TableSummary& t : tables) {
     o << "#### " << t.name << " (" << t.runs << " runs, " << fmt("%.1f", t.hours)
       << " h of data)\n\n";
+    if (!t.note.empty()) o << t.note << ".\n\n";
     o << "| method | detected | isolated | detected when armed at onset | false alarms "
-         "(healthy h) | per healthy h | delay median / p95 [s] | recovery median / p95 [s] "
+         "(healthy h) | per healthy h | per armed healthy h (h) | delay median / p95 [s] | "
+         "recovery median / p95 [s] "
          "(cleared) | armed (runs) | arming median / max [s] | Â error median / p95 |\n";
-    o << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    o << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (int k = 0; k < kMethods; ++k) {
       const MethodSummary& m = t.m[k];
       o << "| " << method_name(k) << " | " << pct(m.detected, m.faults) << " | "
         << pct(m.isolated, m.faults) << " | " << pct(m.detected_armed, m.armed_at_onset) << " | "
         << m.false_alarms << " (" << fmt("%.1f", m.healthy_hours) << ") | "
-        << fmt("%.2f", m.fa_per_hour()) << " | " << fmt("%.2f", m.delay_median) << " / "
+        << fmt("%.2f", m.fa_per_hour()) << " | " << fmt("%.2f", m.fa_per_armed_hour()) << " ("
+        << fmt("%.1f", m.healthy_armed_hours) << ") | " << fmt("%.2f", m.delay_median) << " / "
         << fmt("%.2f", m.delay_p95) << " | " << fmt("%.1f", m.recovery_median) << " / "
         << fmt("%.1f", m.recovery_p95) << " (" << m.recovered << "/" << m.detected << ") | "
         << m.armed_runs << "/" << m.runs << " | " << fmt("%.0f", m.arming_median) << " / "
@@ -98,8 +101,8 @@ std::string to_json(const std::vector<Case>& cases, const std::vector<CaseResult
   o << "{\n  \"header\": " << json_str(header) << ",\n  \"tables\": [\n";
   for (std::size_t ti = 0; ti < tables.size(); ++ti) {
     const TableSummary& t = tables[ti];
-    o << "    {\"name\": " << json_str(t.name) << ", \"runs\": " << t.runs
-      << ", \"hours\": " << json_num(t.hours) << ", \"methods\": {";
+    o << "    {\"name\": " << json_str(t.name) << ", \"note\": " << json_str(t.note)
+      << ", \"runs\": " << t.runs << ", \"hours\": " << json_num(t.hours) << ", \"methods\": {";
     for (int k = 0; k < kMethods; ++k) {
       const MethodSummary& m = t.m[k];
       o << (k ? ", " : "") << json_str(method_name(k)) << ": {\"faults\": " << m.faults
@@ -110,6 +113,8 @@ std::string to_json(const std::vector<Case>& cases, const std::vector<CaseResult
         << ", \"healthy_hours\": " << json_num(m.healthy_hours)
         << ", \"healthy_armed_hours\": " << json_num(m.healthy_armed_hours)
         << ", \"false_alarms_per_hour\": " << json_num(m.fa_per_hour())
+        << ", \"false_alarms_armed\": " << m.false_alarms_armed
+        << ", \"false_alarms_per_armed_hour\": " << json_num(m.fa_per_armed_hour())
         << ", \"delay_median\": " << json_num(m.delay_median)
         << ", \"delay_p95\": " << json_num(m.delay_p95)
         << ", \"recovery_median\": " << json_num(m.recovery_median)

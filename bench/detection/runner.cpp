@@ -1,5 +1,6 @@
 #include "runner.hpp"
 
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -12,7 +13,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
-#include <unistd.h>
 
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
@@ -108,8 +108,8 @@ std::vector<Sample> concatenate(const std::vector<RecordedRun>& runs, double gap
   std::vector<Sample> out;
   double offset = 0.0;
   for (const RecordedRun& run : runs) {
-    const double shift = out.empty() ? -run.samples.front().t
-                                     : out.back().t + gap - run.samples.front().t;
+    const double shift =
+        out.empty() ? -run.samples.front().t : out.back().t + gap - run.samples.front().t;
     offset = shift;
     if (run_starts) run_starts->push_back(run.samples.front().t + offset);
     for (Sample s : run.samples) {
@@ -134,6 +134,11 @@ Vec2 recorded_noise(const std::vector<RecordedRun>& runs) {
   return sigma;
 }
 
+Vec2 fault_sigma_floor() {
+  const IsolationParams p;
+  return Vec2(p.sigma_floor_v, p.sigma_floor_r);
+}
+
 std::string find_realdata(const std::string& source_dir, std::string* why) {
   std::vector<std::string> tried;
   fs::path p = fs::absolute(source_dir);
@@ -145,8 +150,9 @@ std::string find_realdata(const std::string& source_dir, std::string* why) {
     p = p.parent_path();
   }
   if (why) {
-    *why = "the HSVA KVLCC2 data (shared/realdata/kvlcc2-hsva beside the repository) were not "
-           "found; tried:";
+    *why =
+        "the HSVA KVLCC2 data (shared/realdata/kvlcc2-hsva beside the repository) were not "
+        "found; tried:";
     for (const auto& t : tried) *why += " " + t;
   }
   return {};
@@ -213,7 +219,7 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
   } else {
     p.rates = {10.0, 50.0};
     p.voyages = {"courses", "courses-waves"};
-    p.seeds = 5;
+    p.seeds = 10;
     p.onset = 900.0;
     p.fault_len = 60.0;
     p.tail = 120.0;
@@ -231,10 +237,17 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
     for (double rate : p.rates) {
       const std::string table = v.name + " @ " + rate_name(rate);
       if (!keep(table)) continue;
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "core simulator, sigma_v = %.2g m/s, sigma_r = %.2g rad/s",
+                    v.sigma_v, v.sigma_r);
+      std::string note = buf;
+      note += "; voyages:";
+      for (const std::string& voyage : p.voyages) note += " " + voyage;
       for (const std::string& voyage : p.voyages) {
         for (int h = 0; h < p.healthy_seeds; ++h) {
           Case c;
           c.table = table;
+          c.note = note;
           c.subject = v.name;
           c.voyage = voyage;
           c.rate_hz = rate;
@@ -253,6 +266,7 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
             for (const FaultSpec& spec : standard_faults(sigma)) {
               Case c;
               c.table = table;
+              c.note = note;
               c.subject = v.name;
               c.voyage = voyage;
               c.rate_hz = rate;
@@ -291,6 +305,7 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
       for (std::size_t i = 0; i < runs->size(); ++i) {
         Case c;
         c.table = single;
+        c.note = "each recorded test alone; healthy";
         c.subject = "kvlcc2-hsva";
         c.voyage = (*runs)[i].name;
         c.rate_hz = 20.0;
@@ -305,10 +320,18 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
     if (keep(concat)) {
       std::vector<double> starts;
       auto all = std::make_shared<const std::vector<Sample>>(concatenate(*runs, 3.0, &starts));
-      const Vec2 sigma = recorded_noise(*runs);
+      const Vec2 noise = recorded_noise(*runs);
+      const Vec2 sigma = noise.cwiseMax(fault_sigma_floor());
       const double span = all->back().t - all->front().t;
       Case base;
       base.table = concat;
+      char note[256];
+      std::snprintf(note, sizeof note,
+                    "healthy noise of the recordings sigma_v = %.2g m/s, sigma_r = %.2g rad/s; "
+                    "faults sized with sigma_v = %.2g m/s, sigma_r = %.2g rad/s (at least the "
+                    "engine's scale floors)",
+                    noise(0), noise(1), sigma(0), sigma(1));
+      base.note = note;
       base.subject = "kvlcc2-hsva";
       base.voyage = "13 runs, 3 s apart";
       base.rate_hz = 20.0;
@@ -363,7 +386,8 @@ namespace {
 class AlarmTracker {
  public:
   void on_event(const FaultEvent& e, std::vector<Alarm>* out) {
-    const bool active = e.state == FaultState::kRaised || e.state == FaultState::kActiveAcknowledged;
+    const bool active =
+        e.state == FaultState::kRaised || e.state == FaultState::kActiveAcknowledged;
     bool& was = active_[static_cast<int>(e.sensor)];
     if (active != was) out->push_back(Alarm{e.t, e.sensor, active, e.kind});
     was = active;
@@ -373,7 +397,20 @@ class AlarmTracker {
   std::array<bool, 3> active_{false, false, false};
 };
 
-bool detecting(const IsolatorStatus& st) { return st.armed && !st.learning && !st.settling; }
+/// Detection is live: armed, settled and learned. The flags are those of the last update, so
+/// the sample on which set_estimate arms (after its update) does not count yet.
+class ArmingClock {
+ public:
+  void after_sample(double t, const IsolatorStatus& st, double* t_armed) {
+    if (std::isnan(*t_armed) && armed_before_ && st.armed && !st.learning && !st.settling) {
+      *t_armed = t;
+    }
+    armed_before_ = st.armed;
+  }
+
+ private:
+  bool armed_before_ = false;
+};
 
 }  // namespace
 
@@ -381,6 +418,7 @@ MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samp
   MethodResult r;
   FdiEngine engine(cfg);
   AlarmTracker tracker;
+  ArmingClock clock;
   std::vector<FaultEvent> events;
   for (const Sample& s : samples) {
     events.clear();
@@ -394,7 +432,7 @@ MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samp
         }
       }
     }
-    if (std::isnan(r.t_armed) && detecting(engine.isolation_status())) r.t_armed = s.t;
+    clock.after_sample(s.t, engine.isolation_status(), &r.t_armed);
   }
   r.A_final = engine.estimate().A;
   r.converged = engine.estimate().converged;
@@ -414,6 +452,7 @@ MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2
   est.status = IdentStatus::kConverged;
   est.excitation = 1.0;
   AlarmTracker tracker;
+  ArmingClock clock;
   std::vector<Detection> dets;
   bool given = false;
   for (const Sample& s : samples) {
@@ -436,7 +475,7 @@ MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2
       iso.set_estimate(est);
       given = true;
     }
-    if (std::isnan(r.t_armed) && detecting(iso.status())) r.t_armed = s.t;
+    clock.after_sample(s.t, iso.status(), &r.t_armed);
   }
   r.A_final = A;
   r.converged = true;
@@ -489,6 +528,7 @@ std::vector<TableSummary> summarise(const std::vector<Case>& cases,
     const std::size_t ti = static_cast<std::size_t>(&t - tables.data());
     if (acc.size() <= ti) acc.resize(ti + 1);
     ++t.runs;
+    if (t.note.empty()) t.note = c.note;
     t.hours += (r.t_last - r.t_first) / 3600.0;
     for (int k = 0; k < kMethods; ++k) {
       MethodSummary& m = t.m[k];
@@ -502,13 +542,16 @@ std::vector<TableSummary> summarise(const std::vector<Case>& cases,
       const double ref = c.A_ref.norm();
       a.a_error.push_back(ref > 0 ? (mr.A_final - c.A_ref).norm() / ref : kNaN);
       m.false_alarms += static_cast<int>(mr.score.false_alarms());
+      for (double tf : mr.score.false_alarm_times) {
+        if (std::isfinite(mr.t_armed) && tf >= mr.t_armed) ++m.false_alarms_armed;
+      }
       m.healthy_hours += mr.score.healthy_time / 3600.0;
       m.healthy_armed_hours += mr.score.healthy_armed_time / 3600.0;
       for (const FaultScore& f : mr.score.faults) {
         ++m.faults;
         const auto& kinds = standard_kinds();
-        const std::size_t kind =
-            static_cast<std::size_t>(std::find(kinds.begin(), kinds.end(), f.fault.kind) - kinds.begin());
+        const std::size_t kind = static_cast<std::size_t>(
+            std::find(kinds.begin(), kinds.end(), f.fault.kind) - kinds.begin());
         if (kind < kinds.size()) ++m.per_kind[kind][0];
         if (f.armed_at_onset) ++m.armed_at_onset;
         if (!f.detected) continue;
@@ -597,9 +640,10 @@ std::vector<CaseResult> run_all(const std::vector<Case>& cases, const BenchOptio
       const double el = std::chrono::duration<double>(now - t0).count();
       const double h = data_hours.load();
       const double eta = h > 0 ? el * (total_hours - h) / h : 0.0;
-      std::fprintf(stderr, "%sbench detection: %zu/%zu runs, %.1f/%.1f h of data, %.0f s elapsed, ~%.0f s left%s",
-                   tty ? "\r" : "", done.load(), cases.size(), h, total_hours, el, eta,
-                   tty ? "   " : "\n");
+      std::fprintf(
+          stderr,
+          "%sbench detection: %zu/%zu runs, %.1f/%.1f h of data, %.0f s elapsed, ~%.0f s left%s",
+          tty ? "\r" : "", done.load(), cases.size(), h, total_hours, el, eta, tty ? "   " : "\n");
       std::fflush(stderr);
     }
   }

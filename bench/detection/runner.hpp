@@ -26,16 +26,17 @@ struct Stream {
 /// for the engine and the paper's method, A_ref in addition for the oracle.
 struct Case {
   std::string table;    ///< table it belongs to ("mariner @ 10 Hz")
+  std::string note;     ///< what the table's runs share (noise, voyages), for its heading
   std::string subject;  ///< hull or data set
   std::string voyage;   ///< scenario name
   double rate_hz = 0.0;
   std::uint64_t seed = 0;
   bool faulty = false;
-  InjectedFault fault;  ///< when faulty
+  InjectedFault fault;     ///< when faulty
   double magnitude = 0.0;  ///< the injection's magnitude (channel unit, or relative for scale)
   double duration = 0.0;   ///< [s] of data
   Vec2 B = Vec2::Zero();
-  Mat2 A_ref = Mat2::Zero();  ///< true or linearised A (the oracle's; the error reference)
+  Mat2 A_ref = Mat2::Zero();     ///< true or linearised A (the oracle's; the error reference)
   std::function<Stream()> make;  ///< builds the data (deterministic)
 };
 
@@ -60,7 +61,7 @@ struct CaseResult {
 struct BenchOptions {
   bool quick = false;
   int jobs = 1;
-  int seeds = -1;  ///< < 0: the mode's default
+  int seeds = -1;            ///< < 0: the mode's default
   std::string config_dir;    ///< the repository's config/ (default.yaml, paper.yaml)
   std::string realdata_dir;  ///< empty: no real data (say why in realdata_note)
   std::string realdata_note;
@@ -91,6 +92,9 @@ std::vector<RecordedRun> load_hsva(const std::string& dir);
 /// The runs one after another: each starts gap seconds after the previous one's last sample.
 std::vector<Sample> concatenate(const std::vector<RecordedRun>& runs, double gap,
                                 std::vector<double>* run_starts = nullptr);
+/// The engine's floors of the residual scales (IsolationParams::sigma_floor_v, _r): a fault
+/// in units of a recorded channel's sigma is sized with max(recorded_noise, floor).
+Vec2 fault_sigma_floor();
 /// Healthy noise of a recorded channel: 1.4826 MAD of the second difference / sqrt(6) (white
 /// noise: Var(y[k+1] - 2 y[k] + y[k-1]) = 6 sigma^2; the motion's own second difference at
 /// 20 Hz is far below it), pooled over the runs (within runs only).
@@ -123,14 +127,19 @@ struct MethodSummary {
   double delay_median = kNaN, delay_p95 = kNaN;
   double recovery_median = kNaN, recovery_p95 = kNaN;
   int runs = 0, armed_runs = 0;
-  double arming_median = kNaN, arming_max = kNaN;  ///< over the runs that armed [s]
+  double arming_median = kNaN, arming_max = kNaN;    ///< over the runs that armed [s]
   double a_error_median = kNaN, a_error_p95 = kNaN;  ///< ||A^ - A||_F / ||A||_F at the end
   std::vector<std::array<int, 3>> per_kind;  ///< faults, detected, isolated per standard kind
+  int false_alarms_armed = 0;                ///< those raised after arming
   double fa_per_hour() const { return healthy_hours > 0 ? false_alarms / healthy_hours : kNaN; }
+  double fa_per_armed_hour() const {
+    return healthy_armed_hours > 0 ? false_alarms_armed / healthy_armed_hours : kNaN;
+  }
 };
 
 struct TableSummary {
   std::string name;
+  std::string note;
   std::size_t runs = 0;
   double hours = 0.0;  ///< data [h]
   std::array<MethodSummary, kMethods> m;

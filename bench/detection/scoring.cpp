@@ -23,9 +23,8 @@ double overlap(double a, double b, double lo, double hi) {
 
 RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
                    double t_first, double t_last, double t_armed, const ScoreParams& params) {
-  std::sort(faults.begin(), faults.end(), [](const InjectedFault& a, const InjectedFault& b) {
-    return a.t_start < b.t_start;
-  });
+  std::sort(faults.begin(), faults.end(),
+            [](const InjectedFault& a, const InjectedFault& b) { return a.t_start < b.t_start; });
   for (std::size_t i = 0; i < faults.size(); ++i) {
     if (!(faults[i].t_end > faults[i].t_start)) {
       throw std::invalid_argument("fault " + describe(faults[i]) + ": t_end must exceed t_start");

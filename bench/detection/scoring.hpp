@@ -46,13 +46,13 @@ struct ScoreParams {
 struct FaultScore {
   InjectedFault fault;
   bool detected = false;
-  bool isolated = false;              ///< the first raise in the window names the faulty sensor
+  bool isolated = false;  ///< the first raise in the window names the faulty sensor
   Sensor raised_sensor = Sensor::kUnknown;
   FaultKind raised_kind = FaultKind::kUnknown;
-  double delay = kNaN;                ///< first raise - onset [s]
-  bool recovered = false;             ///< every condition cleared after the end (detected only)
-  double recovery_delay = kNaN;       ///< [s]
-  bool armed_at_onset = false;        ///< filled by the caller (the detector's arming time)
+  double delay = kNaN;           ///< first raise - onset [s]
+  bool recovered = false;        ///< every condition cleared after the end (detected only)
+  double recovery_delay = kNaN;  ///< [s]
+  bool armed_at_onset = false;   ///< filled by the caller (the detector's arming time)
 };
 
 struct RunScore {

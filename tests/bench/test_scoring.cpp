@@ -17,8 +17,8 @@ Alarm raise(double t, Sensor s) { return Alarm{t, s, true, FaultKind::kBias}; }
 Alarm clear(double t, Sensor s) { return Alarm{t, s, false, FaultKind::kBias}; }
 
 TEST(BenchScoring, ARaiseInTheWindowDetectsWithItsDelayAndSensor) {
-  const RunScore r = score_run({{kG, FaultKind::kBias, 100, 160}},
-                               {raise(100.4, kG), clear(163, kG)}, 0, 300, 50);
+  const RunScore r =
+      score_run({{kG, FaultKind::kBias, 100, 160}}, {raise(100.4, kG), clear(163, kG)}, 0, 300, 50);
   ASSERT_EQ(r.faults.size(), 1u);
   EXPECT_TRUE(r.faults[0].detected);
   EXPECT_TRUE(r.faults[0].isolated);
@@ -33,25 +33,25 @@ TEST(BenchScoring, ARaiseInTheWindowDetectsWithItsDelayAndSensor) {
 }
 
 TEST(BenchScoring, TheFirstRaiseDecidesTheIsolation) {
-  const RunScore wrong = score_run({{kA, FaultKind::kStuck, 100, 160}},
-                                   {raise(101, kG), raise(102, kA)}, 0, 300, 0);
+  const RunScore wrong =
+      score_run({{kA, FaultKind::kStuck, 100, 160}}, {raise(101, kG), raise(102, kA)}, 0, 300, 0);
   EXPECT_TRUE(wrong.faults[0].detected);
   EXPECT_FALSE(wrong.faults[0].isolated);
   EXPECT_EQ(wrong.faults[0].raised_sensor, kG);
   EXPECT_EQ(wrong.false_alarms(), 0u);  // the second raise is inside the window too
-  const RunScore unknown = score_run({{kA, FaultKind::kStuck, 100, 160}}, {raise(101, kU)}, 0,
-                                     300, 0);
+  const RunScore unknown =
+      score_run({{kA, FaultKind::kStuck, 100, 160}}, {raise(101, kU)}, 0, 300, 0);
   EXPECT_TRUE(unknown.faults[0].detected);
   EXPECT_FALSE(unknown.faults[0].isolated);
 }
 
 TEST(BenchScoring, ARaiseWithinTheGraceAfterTheEndStillDetects) {
-  const RunScore late = score_run({{kA, FaultKind::kDrift, 100, 160}}, {raise(161.5, kA)}, 0,
-                                  300, 0);
+  const RunScore late =
+      score_run({{kA, FaultKind::kDrift, 100, 160}}, {raise(161.5, kA)}, 0, 300, 0);
   EXPECT_TRUE(late.faults[0].detected);
   EXPECT_NEAR(late.faults[0].delay, 61.5, 1e-12);
-  const RunScore after = score_run({{kA, FaultKind::kDrift, 100, 160}}, {raise(162.5, kA)}, 0,
-                                   300, 0);
+  const RunScore after =
+      score_run({{kA, FaultKind::kDrift, 100, 160}}, {raise(162.5, kA)}, 0, 300, 0);
   EXPECT_FALSE(after.faults[0].detected);
   ASSERT_EQ(after.false_alarms(), 1u);
   EXPECT_EQ(after.false_alarm_times[0], 162.5);
@@ -63,10 +63,9 @@ TEST(BenchScoring, ARaiseWithinTheGraceAfterTheEndStillDetects) {
 }
 
 TEST(BenchScoring, RaisesOutsideEveryWindowAreFalseAlarmsAndClearsAreNot) {
-  const RunScore r = score_run({{kG, FaultKind::kNoise, 100, 160}},
-                               {raise(10, kA), clear(12, kA), raise(99.9, kG), clear(200, kG),
-                                raise(250, kU)},
-                               0, 300, 0);
+  const RunScore r = score_run(
+      {{kG, FaultKind::kNoise, 100, 160}},
+      {raise(10, kA), clear(12, kA), raise(99.9, kG), clear(200, kG), raise(250, kU)}, 0, 300, 0);
   ASSERT_EQ(r.false_alarms(), 3u);
   EXPECT_EQ(r.false_alarm_times[0], 10);
   EXPECT_EQ(r.false_alarm_times[1], 99.9);
@@ -84,20 +83,20 @@ TEST(BenchScoring, AHealthyRunIsAllHealthyTimeAndRaisesOutsideItAreIgnored) {
 
 TEST(BenchScoring, RecoveryWaitsForEverySensorAndEndsAtTheNextOnset) {
   // Both sensors raised during the fault; the later clear decides.
-  const RunScore both = score_run({{kG, FaultKind::kBias, 100, 160}},
-                                  {raise(100.2, kG), raise(101, kA), clear(161, kG), clear(170, kA)},
-                                  0, 300, 0);
+  const RunScore both =
+      score_run({{kG, FaultKind::kBias, 100, 160}},
+                {raise(100.2, kG), raise(101, kA), clear(161, kG), clear(170, kA)}, 0, 300, 0);
   EXPECT_TRUE(both.faults[0].recovered);
   EXPECT_NEAR(both.faults[0].recovery_delay, 10.0, 1e-12);
   // Cleared before the end (a scale fault hiding while the course is held): recovery 0.
-  const RunScore early = score_run({{kG, FaultKind::kScale, 100, 160}},
-                                   {raise(100.2, kG), clear(130, kG)}, 0, 300, 0);
+  const RunScore early =
+      score_run({{kG, FaultKind::kScale, 100, 160}}, {raise(100.2, kG), clear(130, kG)}, 0, 300, 0);
   EXPECT_NEAR(early.faults[0].recovery_delay, 0.0, 1e-12);
   // Not cleared before the next fault's onset: not recovered; the second fault is scored
   // on its own window.
-  const RunScore stay = score_run({{kG, FaultKind::kBias, 100, 160}, {kA, FaultKind::kBias, 200, 260}},
-                                  {raise(100.2, kG), raise(200.1, kA), clear(210, kG), clear(262, kA)},
-                                  0, 300, 0);
+  const RunScore stay =
+      score_run({{kG, FaultKind::kBias, 100, 160}, {kA, FaultKind::kBias, 200, 260}},
+                {raise(100.2, kG), raise(200.1, kA), clear(210, kG), clear(262, kA)}, 0, 300, 0);
   EXPECT_FALSE(stay.faults[0].recovered);
   EXPECT_TRUE(stay.faults[1].detected);
   EXPECT_TRUE(stay.faults[1].isolated);
@@ -125,8 +124,8 @@ TEST(BenchScoring, ArmingAfterTheOnsetIsRecordedAndWindowsAreCutAtTheNextOnset) 
 
 TEST(BenchScoring, BadInputIsRefusedWithAReason) {
   EXPECT_THROW(score_run({{kG, FaultKind::kBias, 100, 100}}, {}, 0, 300, 0), std::invalid_argument);
-  EXPECT_THROW(score_run({{kG, FaultKind::kBias, 100, 160}, {kA, FaultKind::kBias, 150, 200}}, {}, 0,
-                         300, 0),
+  EXPECT_THROW(score_run({{kG, FaultKind::kBias, 100, 160}, {kA, FaultKind::kBias, 150, 200}}, {},
+                         0, 300, 0),
                std::invalid_argument);
   EXPECT_THROW(score_run({}, {raise(5, kG), raise(4, kG)}, 0, 300, 0), std::invalid_argument);
   try {
