@@ -49,9 +49,37 @@ std::string json_str(const std::string& s) {
 
 }  // namespace
 
+std::string to_overview(const std::vector<TableSummary>& tables) {
+  std::ostringstream o;
+  o << "| subject @ rate | healthy h | faults |";
+  for (int k = 0; k < kMethods; ++k) {
+    o << " " << method_name(k) << ": detected / isolated | false alarms per h | median delay [s] |";
+  }
+  o << "\n|---|---|---|";
+  for (int k = 0; k < kMethods; ++k) o << "---|---|---|";
+  o << "\n";
+  for (const TableSummary& t : tables) {
+    o << "| " << t.name << " | " << fmt("%.1f", t.m[kOracle].healthy_hours) << " | "
+      << t.m[kOracle].faults << " |";
+    for (int k = 0; k < kMethods; ++k) {
+      const MethodSummary& m = t.m[k];
+      if (m.faults > 0) {
+        o << " " << fmt("%.0f %%", 100.0 * m.detected / m.faults) << " / "
+          << fmt("%.0f %%", 100.0 * m.isolated / m.faults) << " |";
+      } else {
+        o << " – |";
+      }
+      o << " " << fmt("%.2f", m.fa_per_hour()) << " | " << fmt("%.2f", m.delay_median) << " |";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+
 std::string to_markdown(const std::vector<TableSummary>& tables, const std::string& header) {
   std::ostringstream o;
   if (!header.empty()) o << header << "\n\n";
+  o << to_overview(tables) << "\n";
   for (const TableSummary& t : tables) {
     o << "#### " << t.name << " (" << t.runs << " runs, " << fmt("%.1f", t.hours)
       << " h of data)\n\n";
@@ -157,8 +185,10 @@ std::string to_json(const std::vector<Case>& cases, const std::vector<CaseResult
         << ", \"A_final\": [" << json_num(m.A_final(0, 0)) << ", " << json_num(m.A_final(0, 1))
         << ", " << json_num(m.A_final(1, 0)) << ", " << json_num(m.A_final(1, 1)) << "]"
         << ", \"healthy_s\": " << json_num(m.score.healthy_time) << ", \"false_alarms\": [";
-      for (std::size_t j = 0; j < m.score.false_alarm_times.size(); ++j) {
-        o << (j ? ", " : "") << json_num(m.score.false_alarm_times[j]);
+      for (std::size_t j = 0; j < m.score.false_alarm_events.size(); ++j) {
+        const Alarm& a = m.score.false_alarm_events[j];
+        o << (j ? ", " : "") << "[" << json_num(a.t) << ", " << json_str(to_string(a.sensor))
+          << ", " << json_str(to_string(a.kind)) << "]";
       }
       o << "]";
       for (const FaultScore& f : m.score.faults) {

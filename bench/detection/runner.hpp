@@ -160,7 +160,9 @@ void load_configs(const std::string& config_dir, EngineConfig* engine, EngineCon
 std::vector<CaseResult> run_all(const std::vector<Case>& cases, const BenchOptions& opt,
                                 const EngineConfig& engine_cfg, const EngineConfig& paper_cfg);
 
-/// Outputs.
+/// Outputs. The overview: one row per table with each method's key figures.
+std::string to_overview(const std::vector<TableSummary>& tables);
+/// The header, the overview, then every table with its per-kind breakdown.
 std::string to_markdown(const std::vector<TableSummary>& tables, const std::string& header);
 std::string to_json(const std::vector<Case>& cases, const std::vector<CaseResult>& results,
                     const std::vector<TableSummary>& tables, const std::string& header);

@@ -78,6 +78,7 @@ RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& 
     const int w = window_of(a.t);
     if (w < 0) {
       out.false_alarm_times.push_back(a.t);
+      out.false_alarm_events.push_back(a);
       continue;
     }
     FaultScore& fs = out.faults[static_cast<std::size_t>(w)];

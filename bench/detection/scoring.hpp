@@ -58,6 +58,7 @@ struct FaultScore {
 struct RunScore {
   std::vector<FaultScore> faults;
   std::vector<double> false_alarm_times;  ///< [s]
+  std::vector<Alarm> false_alarm_events;  ///< the same raises, with their sensor and kind
   double span = 0.0;                      ///< t_last - t_first [s]
   double healthy_time = 0.0;              ///< span minus detection windows [s]
   double healthy_armed_time = 0.0;        ///< the part of it after arming [s]

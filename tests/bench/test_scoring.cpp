@@ -70,6 +70,8 @@ TEST(BenchScoring, RaisesOutsideEveryWindowAreFalseAlarmsAndClearsAreNot) {
   EXPECT_EQ(r.false_alarm_times[0], 10);
   EXPECT_EQ(r.false_alarm_times[1], 99.9);
   EXPECT_EQ(r.false_alarm_times[2], 250);
+  ASSERT_EQ(r.false_alarm_events.size(), 3u);
+  EXPECT_EQ(r.false_alarm_events[2].sensor, kU);
   // A condition already raised at the onset does not detect the fault: no new raise.
   EXPECT_FALSE(r.faults[0].detected);
 }
