@@ -16,10 +16,12 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "sim_voyage.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/io/scenarios.hpp"
+#include "usv_fdi/sim/voyage.hpp"
 #ifdef USV_FDI_APP_WITH_DDS
 #include "dds_options.hpp"
 #include "sim_publish.hpp"
@@ -40,6 +42,7 @@ struct SimArgs {
   std::string steering;  ///< empty: the scenario's
   double noise_scale = 1.0;
   std::string output;
+  VoyageArgs voyage;  ///< options of the voyage scenarios (sim_voyage.cpp)
 #ifdef USV_FDI_APP_WITH_DDS
   bool publish = false;
   std::vector<std::uint32_t> mmsi;
@@ -70,10 +73,58 @@ bool split_fault_target(const std::string& spec, std::uint32_t* mmsi, std::strin
   return true;
 }
 
+bool is_classic(const std::string& scenario) {
+  return scenario == "paper" || scenario == "healthy" || scenario == "faults";
+}
+
+/// A voyage scenario: the voyage simulator over any hull (sim_voyage.cpp).
+int run_voyage_scenario(const SimArgs& a) {
+  if (!a.steering.empty()) {
+    spdlog::error("--steering applies to the classic scenarios (paper, healthy, faults) only");
+    return kExitUsage;
+  }
+#ifdef USV_FDI_APP_WITH_DDS
+  if (a.publish) {
+    spdlog::error("--publish runs the classic scenarios (paper, healthy, faults) only");
+    return kExitUsage;
+  }
+  if (!a.mmsi.empty() || !a.healthy.empty()) {
+    spdlog::error("--mmsi and --healthy only apply with --publish");
+    return kExitUsage;
+  }
+#endif
+  if (a.output.empty()) {
+    spdlog::error("sim: give --output FILE");
+    return kExitUsage;
+  }
+  VoyageCommon c;
+  c.vessel = a.vessel;
+  c.scenario = a.scenario;
+  c.output = a.output;
+  c.rate_hz = a.rate_hz;
+  c.duration = a.duration;
+  c.seed = a.seed;
+  c.noise_scale = a.noise_scale;
+  c.faults = a.faults;
+  return run_voyage_sim(c, a.voyage);
+}
+
 int run_sim(const SimArgs& a) {
+  if (!is_classic(a.scenario)) return run_voyage_scenario(a);
   VesselModel vessel;
-  if (!find_vessel(a.vessel, &vessel)) {  // unreachable: CLI11 checks the name
-    spdlog::error("unknown vessel '{}'", a.vessel);
+  if (!find_vessel(a.vessel, &vessel)) {
+    spdlog::error(
+        "--vessel '{}': the classic scenarios (paper, healthy, faults) run the shipped "
+        "vessels only; give a voyage scenario (--scenario course, voyage, ...)",
+        a.vessel);
+    return kExitUsage;
+  }
+  if (a.voyage.any()) {
+    spdlog::error(
+        "--sea-state, --current, --wind, --sensor, --fault-set, --fault-sigma and "
+        "--dither need a voyage scenario (course, zigzag10, zigzag20, turn, speed, "
+        "slow, voyage, hold), not '{}'",
+        a.scenario);
     return kExitUsage;
   }
   SimConfig c;
@@ -225,19 +276,30 @@ void register_sim_command(CommandRegistry& registry) {
   auto args = std::make_shared<SimArgs>();
   CLI::App* sub =
       registry.add("sim",
-                   "Simulate a shipped vessel with optional INS faults and write CSV rows "
-                   "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; %.17g)",
+                   "Simulate a vessel with optional INS faults and write CSV rows "
+                   "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
+                   "scenarios add u and more; %.17g)",
                    [args] { return run_sim(*args); });
   std::vector<std::string> names;
   for (const VesselModel& m : shipped_vessels()) names.push_back(m.name);
-  sub->add_option("--vessel", args->vessel, "shipped vessel model")
+  for (const std::string& n : voyage_vessel_names()) {
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  }
+  sub->add_option("--vessel", args->vessel,
+                  "vessel: a shipped model, or with a voyage scenario any hull of "
+                  "`usv-fdi vessels`")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
+  std::vector<std::string> scenarios = {"paper", "healthy", "faults"};
+  for (const std::string& n : sim::scenario_names()) scenarios.push_back(n);
   sub->add_option("--scenario", args->scenario,
-                  "paper: gyro bias (20,40) s, accelerometer bias (60,80) s, sine rudder; "
-                  "healthy: autopilot voyage without faults; faults: one fault of every kind "
-                  "on alternating sensors after the engine has learned")
-      ->check(CLI::IsMember({"paper", "healthy", "faults"}))
+                  "classic (shipped vessels, core simulator): paper: gyro bias (20,40) s, "
+                  "accelerometer bias (60,80) s, sine rudder; healthy: autopilot voyage without "
+                  "faults; faults: one fault of every kind on alternating sensors after the "
+                  "engine has learned. Voyages (voyage simulator): hold, course (+-10 deg), "
+                  "zigzag10, zigzag20, turn (turning circles), speed (throttle -30 %/+30 %), "
+                  "slow (50 % throttle), voyage (all of them)")
+      ->check(CLI::IsMember(scenarios))
       ->capture_default_str();
   sub->add_option("--rate", args->rate_hz, "sample rate [Hz]")
       ->check(CLI::PositiveNumber)
@@ -249,6 +311,7 @@ void register_sim_command(CommandRegistry& registry) {
                   "extra fault [MMSI@]sensor:kind:start:end[:magnitude[:spike_rate]] "
                   "(e.g. gyro:bias:20:40:0.005; MMSI@ limits it to one vessel with --publish); "
                   "repeatable");
+  add_voyage_options(sub, &args->voyage);
   sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
       ->check(CLI::IsMember({"autopilot", "sine"}));
   sub->add_option("--noise-scale", args->noise_scale,

@@ -1,0 +1,49 @@
+// usv-fdi sim with a voyage scenario: any hull (shipped vessels and the vessel zoo) under
+// the voyage simulator of src/sim (autopilot, manoeuvres, waves, wind, current, sensors).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "usv_fdi/sim/hull.hpp"
+
+namespace usvfdi::app {
+
+/// The options of `usv-fdi sim` that only voyages take.
+struct VoyageArgs {
+  std::optional<int> sea_state;
+  std::optional<double> wave_period;
+  std::string current;  ///< SPEED[:SET_DEG]
+  std::string wind;     ///< DEG[:GUST_DEG]
+  std::vector<std::string> sensor;
+  std::string fault_set;
+  std::vector<std::string> sigma_faults;
+  std::string dither;  ///< DEG[:PERIOD]
+  /// True when any voyage-only option was given (an error with a classic scenario).
+  bool any() const;
+};
+
+/// The common options of `usv-fdi sim` a voyage uses too.
+struct VoyageCommon {
+  std::string vessel, scenario, output;
+  double rate_hz = 50.0;
+  std::optional<double> duration;
+  std::uint64_t seed = 1;
+  double noise_scale = 1.0;
+  std::vector<std::string> faults;  ///< channel units, as in the classic scenarios
+};
+
+/// Every hull `--vessel` accepts with a voyage scenario.
+std::vector<std::string> voyage_vessel_names();
+/// The hull of that name (the zoo's, else a shipped vessel as a linear hull); nullptr if none.
+std::shared_ptr<const sim::Hull> find_voyage_hull(const std::string& name);
+void add_voyage_options(CLI::App* sub, VoyageArgs* a);
+/// Runs the voyage and writes its CSV; returns the exit code.
+int run_voyage_sim(const VoyageCommon& common, const VoyageArgs& a);
+
+}  // namespace usvfdi::app

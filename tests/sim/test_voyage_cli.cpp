@@ -1,0 +1,109 @@
+// usv-fdi sim with voyage scenarios, end to end: the CSV, its determinism, replay of it, and
+// the messages on bad options.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+const std::string kExe = USV_FDI_EXE;
+const std::string kSource = USV_FDI_SOURCE_DIR;
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::ostringstream os;
+  os << f.rdbuf();
+  return os.str();
+}
+
+class VoyageCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = ::testing::TempDir() + "usv_fdi_voyage_" + info->name() + "_" +
+           std::to_string(::getpid()) + "/";
+    ASSERT_EQ(std::system(("mkdir -p '" + dir_ + "'").c_str()), 0);
+  }
+  void TearDown() override {
+    if (HasFailure()) return;
+    EXPECT_EQ(std::system(("rm -rf '" + dir_ + "'").c_str()), 0);
+  }
+  std::string path(const std::string& name) const { return dir_ + name; }
+  Outcome run(const std::string& args) const {
+    Outcome r;
+    const std::string out = path("stdout.txt"), err = path("stderr.txt");
+    const int status =
+        std::system(("'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'").c_str());
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+  std::string dir_;
+};
+
+TEST_F(VoyageCli, WritesTheSimColumnsAndUAndTheSameSeedGivesTheSameFile) {
+  const std::string args =
+      "sim --vessel otter --scenario voyage --rate 10 --duration 200 --sea-state 3 "
+      "--current 0.2 --wind 1 --sensor mems --fault-sigma gyro:bias:100:120:10 --output ";
+  ASSERT_EQ(run(args + "'" + path("a.csv") + "'").code, 0);
+  const Outcome b = run(args + "'" + path("b.csv") + "'");
+  ASSERT_EQ(b.code, 0) << b.err;
+  const std::string a = slurp(path("a.csv"));
+  EXPECT_EQ(a, slurp(path("b.csv")));
+  EXPECT_EQ(a.rfind("t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g,u,", 0), 0u);
+  EXPECT_NE(a.find(",bias,"), std::string::npos);
+  EXPECT_NE(b.err.find("linearised B = [0.165394, -2.194]"), std::string::npos) << b.err;
+  EXPECT_NE(b.err.find("fault gyro:bias:100:120:0.005"), std::string::npos) << b.err;
+  const Outcome c = run(args + "'" + path("c.csv") + "' --seed 2");
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(a, slurp(path("c.csv")));
+}
+
+TEST_F(VoyageCli, ReplayReadsAVoyageCsv) {
+  ASSERT_EQ(run("sim --vessel otter --scenario course --rate 10 --duration 120 --sensor mems "
+                "--output '" +
+                path("v.csv") + "'")
+                .code,
+            0);
+  const Outcome r = run("replay --config '" + kSource + "/config/vessels/otter.yaml' --input '" +
+                        path("v.csv") + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"type\":\"summary\""), std::string::npos);
+  EXPECT_NE(r.out.find("\"complete\":true"), std::string::npos);
+}
+
+TEST_F(VoyageCli, BadVoyageOptionsAreNamed) {
+  const std::string out = " --output '" + path("x.csv") + "'";
+  struct Case {
+    std::string args, says;
+  };
+  const Case cases[] = {
+      {"--scenario course --sea-state 2", "sea state 2: expected 0 (calm), 3, 4, 5 or 6"},
+      {"--scenario paper --sea-state 4", "need a voyage scenario"},
+      {"--scenario course --sensor gyro.gm=oops", "--sensor 'gyro.gm=oops': not a number: 'oops'"},
+      {"--scenario course --sensor fancy", "--sensor 'fancy': unknown preset"},
+      {"--scenario course --current fast", "--current 'fast': expected SPEED[:SET_DEG]"},
+      {"--scenario course --wind 1:-2", "--wind '1:-2'"},
+      {"--scenario course --dither 1:0", "--dither '1:0'"},
+      {"--scenario course --steering sine", "--steering applies to the classic scenarios"},
+      {"--scenario course --wave-period 8", "--wave-period needs a --sea-state"},
+      {"--scenario course --fault-sigma gyro:bogus:1:2:3", "unknown kind 'bogus'"},
+  };
+  for (const Case& c : cases) {
+    const Outcome r = run("sim --vessel otter " + c.args + out);
+    EXPECT_EQ(r.code, 64) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+  }
+}
+
+}  // namespace
