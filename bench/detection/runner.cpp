@@ -18,6 +18,8 @@
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/csv.hpp"
+#include "usv_fdi/sim/hulls.hpp"
+#include "usv_fdi/sim/voyage.hpp"
 
 namespace usvfdi::bench {
 
@@ -160,6 +162,10 @@ std::string find_realdata(const std::string& source_dir, std::string* why) {
 
 namespace {
 
+// The INS of every simulated hull (the measurements: 1 cm/s and 0.03 deg/s).
+constexpr double kInsSigmaV = 0.01;                                   // [m/s]
+constexpr double kInsSigmaR = 0.03 * 3.14159265358979323846 / 180.0;  // [rad/s]
+
 std::uint64_t mix_seed(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -173,6 +179,60 @@ std::string rate_name(double hz) {
   return o.str();
 }
 
+struct Subject {
+  std::string name;
+  std::shared_ptr<const sim::Hull> hull;
+  sim::Linearisation lin;
+};
+
+/// Every hull of the zoo at its nominal speed, and the shipped Otter (the linear model the
+/// engine's defaults were developed on) as a linear hull.
+std::vector<Subject> zoo_subjects() {
+  std::vector<Subject> out;
+  for (const sim::ZooEntry& e : sim::zoo()) {
+    out.push_back(Subject{e.name, e.hull, sim::linearise(*e.hull, e.hull->nominal_speed())});
+  }
+  if (auto otter = sim::make_linear_hull("otter")) {
+    out.push_back(Subject{"otter-linear", otter, sim::linearise(*otter, otter->nominal_speed())});
+  }
+  return out;
+}
+
+sim::VoyageConfig voyage_config(const sim::Hull& hull, const std::string& voyage) {
+  sim::VoyageConfig c;
+  if (voyage == "course/calm") {
+    c.legs = sim::scenario_legs("course", hull);
+    sim::sensor_preset("ideal", kInsSigmaV, kInsSigmaR, &c.sensors);
+  } else if (voyage == "voyage/sea3/mems") {
+    c.legs = sim::scenario_legs("voyage", hull);
+    c.environment.sea = sim::sea_state(3);
+    c.environment.current = 0.1;
+    c.environment.current_sigma = 0.05;
+    c.environment.wind = 0.5 * M_PI / 180.0;
+    c.environment.wind_sigma = 0.5 * M_PI / 180.0;
+    sim::sensor_preset("mems", kInsSigmaV, kInsSigmaR, &c.sensors);
+  } else {
+    throw std::invalid_argument("unknown benchmark voyage '" + voyage + "'");
+  }
+  return c;
+}
+
+/// 5 s before the first leg that begins at or after t (legs by their nominal durations,
+/// repeated as the voyage repeats them).
+double onset_before_leg(const sim::Hull& hull, const std::string& voyage, double t) {
+  const std::vector<sim::Leg> legs = voyage_config(hull, voyage).legs;
+  double total = 0.0;
+  for (const sim::Leg& l : legs) total += l.duration;
+  if (!(total > 0)) return t;
+  double b = std::floor(t / total) * total;
+  for (;;) {
+    for (const sim::Leg& l : legs) {
+      if (b >= t) return b - 5.0;
+      b += l.duration;
+    }
+  }
+}
+
 struct Plan {
   std::vector<double> rates;
   std::vector<std::string> voyages;
@@ -182,21 +242,19 @@ struct Plan {
   double healthy_len = 0.0;
 };
 
-Stream sim_stream(const VesselModel& v, const std::string& voyage, double rate, std::uint64_t seed,
-                  double duration, const std::vector<FaultInjection>& faults) {
-  SimConfig c;
-  c.vessel = v;
+Stream voyage_stream(const std::shared_ptr<const sim::Hull>& hull, const std::string& voyage,
+                     double rate, std::uint64_t seed, double duration,
+                     const std::vector<FaultInjection>& faults) {
+  sim::VoyageConfig c = voyage_config(*hull, voyage);
   c.rate_hz = rate;
   c.duration = duration;
   c.seed = seed;
-  c.autopilot_on_measurement = true;  // closed loop: the INS noise and faults steer the rudder
-  if (voyage == "courses-waves") c.disturbance = 0.2 * v.sigma_v;
   c.faults = faults;
   Stream st;
-  Simulator sim(c);
-  SimRow row;
+  sim::Voyage run(hull, c);
+  sim::VoyageRow row;
   st.samples.reserve(static_cast<std::size_t>(duration * rate) + 2);
-  while (sim.next(&row)) st.samples.push_back(Sample{row.t, row.v, row.r, row.delta});
+  while (run.next(&row)) st.samples.push_back(Sample{row.t, row.v, row.r, row.delta});
   for (const FaultInjection& f : faults) {
     st.faults.push_back(InjectedFault{f.sensor, f.kind, f.t_start, f.t_end});
   }
@@ -209,7 +267,7 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
   Plan p;
   if (opt.quick) {
     p.rates = {10.0, 50.0};
-    p.voyages = {"courses"};
+    p.voyages = {"course/calm"};
     p.seeds = 1;
     p.onset = 200.0;
     p.fault_len = 60.0;
@@ -218,8 +276,8 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
     p.healthy_len = 600.0;
   } else {
     p.rates = {10.0, 50.0};
-    p.voyages = {"courses", "courses-waves"};
-    p.seeds = 10;
+    p.voyages = {"course/calm", "voyage/sea3/mems"};
+    p.seeds = 5;
     p.onset = 900.0;
     p.fault_len = 60.0;
     p.tail = 120.0;
@@ -233,58 +291,64 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
     return opt.only.empty() || table.find(opt.only) != std::string::npos;
   };
   std::uint64_t serial = 0;
-  for (const VesselModel& v : shipped_vessels()) {
+  for (const Subject& sub : zoo_subjects()) {
     for (double rate : p.rates) {
-      const std::string table = v.name + " @ " + rate_name(rate);
+      const std::string table = sub.name + " @ " + rate_name(rate);
       if (!keep(table)) continue;
-      char buf[256];
-      std::snprintf(buf, sizeof buf, "core simulator, sigma_v = %.2g m/s, sigma_r = %.2g rad/s",
-                    v.sigma_v, v.sigma_r);
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "%s model at %.4g m/s (B and the oracle's A from its linearisation); INS "
+                    "white noise sigma_v = %.2g m/s, sigma_r = %.2g rad/s; voyages:",
+                    sub.hull->nonlinear() ? "nonlinear 3-DOF" : "linear", sub.lin.u0, kInsSigmaV,
+                    kInsSigmaR);
       std::string note = buf;
-      note += "; voyages:";
       for (const std::string& voyage : p.voyages) note += " " + voyage;
       for (const std::string& voyage : p.voyages) {
         for (int h = 0; h < p.healthy_seeds; ++h) {
           Case c;
           c.table = table;
           c.note = note;
-          c.subject = v.name;
+          c.subject = sub.name;
           c.voyage = voyage;
           c.rate_hz = rate;
           c.seed = mix_seed(++serial);
           c.duration = p.healthy_len;
-          c.B = v.B;
-          c.A_ref = v.A;
-          c.make = [v, voyage, rate, seed = c.seed, d = c.duration] {
-            return sim_stream(v, voyage, rate, seed, d, {});
+          c.B = sub.lin.B;
+          c.A_ref = sub.lin.A;
+          c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration] {
+            return voyage_stream(hull, voyage, rate, seed, d, {});
           };
           cases.push_back(std::move(c));
         }
         for (int s = 0; s < p.seeds; ++s) {
+          // The onset moves with the seed, so that the faults meet different manoeuvres,
+          // and lies 5 s before a leg begins: a scale error, invisible while the vessel
+          // holds its course, meets a manoeuvre within the fault.
+          const double onset = onset_before_leg(*sub.hull, voyage, p.onset + 61.0 * s);
           for (Sensor sensor : {Sensor::kAccelerometer, Sensor::kGyro}) {
-            const double sigma = sensor == Sensor::kAccelerometer ? v.sigma_v : v.sigma_r;
+            const double sigma = sensor == Sensor::kAccelerometer ? kInsSigmaV : kInsSigmaR;
             for (const FaultSpec& spec : standard_faults(sigma)) {
               Case c;
               c.table = table;
               c.note = note;
-              c.subject = v.name;
+              c.subject = sub.name;
               c.voyage = voyage;
               c.rate_hz = rate;
               c.seed = mix_seed(++serial);
               c.faulty = true;
-              c.fault = InjectedFault{sensor, spec.kind, p.onset, p.onset + p.fault_len};
+              c.fault = InjectedFault{sensor, spec.kind, onset, onset + p.fault_len};
               c.magnitude = spec.magnitude;
-              c.duration = p.onset + p.fault_len + p.tail;
-              c.B = v.B;
-              c.A_ref = v.A;
+              c.duration = onset + p.fault_len + p.tail;
+              c.B = sub.lin.B;
+              c.A_ref = sub.lin.A;
               FaultInjection fi;
               fi.sensor = sensor;
               fi.kind = spec.kind;
               fi.t_start = c.fault.t_start;
               fi.t_end = c.fault.t_end;
               fi.magnitude = spec.magnitude;
-              c.make = [v, voyage, rate, seed = c.seed, d = c.duration, fi] {
-                return sim_stream(v, voyage, rate, seed, d, {fi});
+              c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration, fi] {
+                return voyage_stream(hull, voyage, rate, seed, d, {fi});
               };
               cases.push_back(std::move(c));
             }
