@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers.hpp"
 #include "scoring.hpp"
 #include "usv_fdi/core/engine.hpp"
 
@@ -42,14 +43,6 @@ struct Case {
 
 enum Method : int { kEngine = 0, kPaper = 1, kOracle = 2, kMethods = 3 };
 const char* method_name(int m);
-
-struct MethodResult {
-  std::vector<Alarm> alarms;
-  double t_armed = kNaN;  ///< first time detection was armed
-  Mat2 A_final = Mat2::Zero();
-  bool converged = false;  ///< the estimate said so at the end
-  RunScore score;
-};
 
 struct CaseResult {
   std::size_t index = 0;
@@ -110,13 +103,6 @@ std::vector<Case> make_cases(const BenchOptions& opt);
 /// Runs the three detectors on one case.
 CaseResult run_case(const Case& c, std::size_t index, const EngineConfig& engine_cfg,
                     const EngineConfig& paper_cfg, const ScoreParams& score);
-
-/// The oracle: the engine's isolation stage (Isolator + FaultLatch, default IsolationParams)
-/// given a converged Estimate with A_ref from the first sample on.
-MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2& A,
-                        const std::vector<Sample>& samples);
-/// The engine (FdiEngine) with cfg, every event acknowledged at once.
-MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samples);
 
 /// Aggregate of one method over one table.
 struct MethodSummary {
