@@ -185,15 +185,14 @@ struct Subject {
   sim::Linearisation lin;
 };
 
-/// Every hull of the zoo at its nominal speed, and the shipped Otter (the linear model the
-/// engine's defaults were developed on) as a linear hull.
+/// Every hull a voyage can drive (sim::voyage_hull_names(): the vessel zoo, then the shipped
+/// Otter, the linear model the engine's defaults were developed on) at its nominal speed.
 std::vector<Subject> zoo_subjects() {
   std::vector<Subject> out;
-  for (const sim::ZooEntry& e : sim::zoo()) {
-    out.push_back(Subject{e.name, e.hull, sim::linearise(*e.hull, e.hull->nominal_speed())});
-  }
-  if (auto otter = sim::make_linear_hull("otter")) {
-    out.push_back(Subject{"otter-linear", otter, sim::linearise(*otter, otter->nominal_speed())});
+  for (const std::string& name : sim::voyage_hull_names()) {
+    std::shared_ptr<const sim::Hull> hull = sim::voyage_hull(name);
+    if (!hull) throw std::logic_error("voyage hull '" + name + "' is listed but not made");
+    out.push_back(Subject{name, hull, sim::linearise(*hull, hull->nominal_speed())});
   }
   return out;
 }
