@@ -15,7 +15,6 @@
 #include <thread>
 
 #include "usv_fdi/core/simulator.hpp"
-#include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/sim/hulls.hpp"
@@ -163,8 +162,9 @@ std::string find_realdata(const std::string& source_dir, std::string* why) {
 namespace {
 
 // The INS of every simulated hull (the measurements: 1 cm/s and 0.03 deg/s).
-constexpr double kInsSigmaV = 0.01;                                   // [m/s]
-constexpr double kInsSigmaR = 0.03 * 3.14159265358979323846 / 180.0;  // [rad/s]
+constexpr double kInsSigmaV = 0.01;                      // [m/s]
+constexpr double kDeg = 3.14159265358979323846 / 180.0;  // [rad]
+constexpr double kInsSigmaR = 0.03 * kDeg;               // [rad/s]
 
 std::uint64_t mix_seed(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
@@ -207,8 +207,8 @@ sim::VoyageConfig voyage_config(const sim::Hull& hull, const std::string& voyage
     c.environment.sea = sim::sea_state(3);
     c.environment.current = 0.1;
     c.environment.current_sigma = 0.05;
-    c.environment.wind = 0.5 * M_PI / 180.0;
-    c.environment.wind_sigma = 0.5 * M_PI / 180.0;
+    c.environment.wind = 0.5 * kDeg;
+    c.environment.wind_sigma = 0.5 * kDeg;
     sim::sensor_preset("mems", kInsSigmaV, kInsSigmaR, &c.sensors);
   } else {
     throw std::invalid_argument("unknown benchmark voyage '" + voyage + "'");
