@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/sim/hulls.hpp"
 
 namespace usvfdi::app {
@@ -62,6 +63,13 @@ int list_zoo() {
     std::printf("  %-17s %s\n", e.name.c_str(), e.hull->source().c_str());
   }
   std::printf("\nusv-fdi vessels --yaml NAME [--speed U] prints the configuration for a hull.\n");
+  std::printf("\nshipped linear models of usv-fdi sim --vessel (with their INS noise):\n");
+  for (const VesselModel& m : shipped_vessels()) {
+    std::printf(
+        "  %-8s u0 %.6g m/s, B: [%.6g, %.6g], sigma_v %.3g m/s, sigma_r %.3g rad/s, "
+        "config/vessels/%s.yaml\n",
+        m.name.c_str(), m.u0, m.B(0), m.B(1), m.sigma_v, m.sigma_r, m.name.c_str());
+  }
   return std::fflush(stdout) == 0 ? kExitOk : kExitOutput;
 }
 

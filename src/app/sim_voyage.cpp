@@ -227,7 +227,7 @@ int run_voyage_sim(const VoyageCommon& c, const VoyageArgs& a) {
     }
   }
   std::ostream& os = to_stdout ? std::cout : file;
-  sim::VoyageCsvWriter writer(os);
+  sim::VoyageCsvWriter writer(os, cfg.sensors);
   sim::VoyageRow row;
   std::size_t rows = 0;
   while (voyage->next(&row)) {

@@ -320,19 +320,28 @@ std::vector<VoyageRow> run_voyage(std::shared_ptr<const Hull> hull, const Voyage
   return rows;
 }
 
-VoyageCsvWriter::VoyageCsvWriter(std::ostream& out) : out_(out) {
+VoyageCsvWriter::VoyageCsvWriter(std::ostream& out, const SensorConfig& sensors) : out_(out) {
+  digits_[0] = sensors.v.quantiser.digits;
+  digits_[1] = sensors.r.quantiser.digits;
+  digits_[2] = sensors.delta.quantiser.digits;
   out_ << "t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g,u,t_true,v_lf,r_lf,"
           "v_wave,r_wave,v_current,psi_meas,delta_cmd,throttle,gyro_bias,dist_v,dist_r,manoeuvre,"
           "duplicate\n";
 }
 
 void VoyageCsvWriter::write(const VoyageRow& w) {
+  char m[3][40];
+  const double meas[3] = {w.v, w.r, w.delta};
+  for (int i = 0; i < 3; ++i) {
+    const int d = std::isfinite(meas[i]) && digits_[i] > 0 ? digits_[i] : 17;
+    std::snprintf(m[i], sizeof m[i], "%.*g", d, meas[i]);
+  }
   char buf[1024];
   const auto kind = [](FaultKind k) { return k == FaultKind::kUnknown ? "" : to_string(k); };
   std::snprintf(buf, sizeof buf,
-                "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s,%s,%.17g,%.17g,%.17g,"
-                "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s,%d\n",
-                w.t, w.v, w.r, w.delta, w.v_true, w.r_true, w.delta_true, w.psi, w.psi_ref,
+                "%.17g,%s,%s,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%s,%s,%.17g,%.17g,%.17g,%.17g,"
+                "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s,%d\n",
+                w.t, m[0], m[1], m[2], w.v_true, w.r_true, w.delta_true, w.psi, w.psi_ref,
                 kind(w.fault_a), kind(w.fault_g), w.u_true, w.t_true, w.v_lf, w.r_lf, w.v_wave,
                 w.r_wave, w.v_current, w.psi_meas, w.delta_cmd, w.throttle, w.gyro_bias, w.dist_v,
                 w.dist_r, to_string(w.manoeuvre), w.duplicate ? 1 : 0);

@@ -91,6 +91,16 @@ TEST(Zoo, CoversSlowShipsCourseUnstableShipsAndUnstableUsvs) {
   EXPECT_FALSE(stable(linearise(hull("otter3dof"), 3.0).A));
 }
 
+TEST(Zoo, TheEssoTankerIsCourseUnstableLoadedInDeepWaterAsItsTrialsFound) {
+  // Full-scale trials of the 193 000 dwt Esso Bernicia (Clarke, Patterson & Wooderson 1973,
+  // Trans. RINA, pp. 89-109): course-unstable in all conditions except deep-water ballast.
+  // The van Berlekom & Goddard model of that tanker size, loaded, in deep water:
+  for (double U : {8.23, 5.0}) {
+    const Linearisation l = linearise(hull("esso-tanker"), U);
+    EXPECT_LT(l.A.determinant(), 0.0) << U;  // one positive real eigenvalue
+  }
+}
+
 // --- Linearisation --------------------------------------------------------------------
 
 TEST(Linearise, AgreesWithFiniteDifferencesAtOtherStepSizes) {
@@ -279,9 +289,10 @@ TEST(Manoeuvre, RudderServoHonoursSaturationAndRateLimit) {
 
 // --- The recorded KVLCC2 zigzags (HSVA, SIMMAN 2008) ----------------------------------
 
+/// The shared data directory: $USV_FDI_SHARED, else ../shared beside the source tree.
 std::string shared_dir() {
   const char* env = std::getenv("USV_FDI_SHARED");
-  return env != nullptr ? env : USV_FDI_SHARED_DIR;
+  return env != nullptr ? env : std::string(USV_FDI_SOURCE_DIR) + "/../shared";
 }
 
 /// Heading [rad] column of an HSVA csv, relative to its first value; empty if unreadable.

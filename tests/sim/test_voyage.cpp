@@ -706,5 +706,32 @@ TEST(VoyageCsv, KeepsTheSimRowColumnsFirstAndTheSurgeSpeedAsU) {
   EXPECT_EQ(f[24], "hold");
 }
 
+TEST(VoyageCsv, AChannelOfThreeSignificantDigitsIsPrintedWithThem) {
+  const auto h = hull("otter");
+  VoyageConfig c = base(*h, "course", 20);
+  c.sensors.v.quantiser.digits = 3;
+  const auto rows = run_voyage(h, c);
+  std::ostringstream os;
+  VoyageCsvWriter w(os, c.sensors);
+  for (const VoyageRow& r : rows) w.write(r);
+  std::istringstream is(os.str());
+  std::string line;
+  std::getline(is, line);
+  for (std::size_t i = 0; std::getline(is, line); ++i) {
+    const std::string v =
+        line.substr(line.find(',') + 1, line.find(',', line.find(',') + 1) - line.find(',') - 1);
+    std::size_t digits = 0;
+    bool leading = true;
+    for (const char ch : v) {
+      if (ch == 'e') break;
+      if (ch < '0' || ch > '9') continue;
+      if (ch != '0') leading = false;
+      if (!leading) ++digits;
+    }
+    EXPECT_LE(digits, 3u) << v;
+    EXPECT_EQ(std::strtod(v.c_str(), nullptr), rows[i].v) << v;  // the same double back
+  }
+}
+
 }  // namespace
 }  // namespace usvfdi::sim

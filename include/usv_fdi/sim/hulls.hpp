@@ -21,7 +21,8 @@ std::shared_ptr<const Hull> make_container();
 /// Esso 190 000 dwt tanker, 304.8 m, deep water (van Berlekom & Goddard 1972).
 std::shared_ptr<const Hull> make_esso_tanker();
 /// KVLCC2 MMG standard model (Yasukawa & Yoshimura 2015) at the scale of length lpp [m]
-/// (7 m: the free-running model; 320 m: the ship) and approach speed u0 [m/s].
+/// (7 m: the free-running model; 320 m: the ship) and approach speed u0 [m/s]; named
+/// "kvlcc2" below 50 m and "kvlcc2-full" above.
 std::shared_ptr<const Hull> make_kvlcc2(double lpp, double u0);
 /// Otter 2 m USV in surge, sway and yaw (Fossen 2021; PythonVehicleSimulator otter.py
 /// parameters), the differential-thrust yaw moment as an equivalent rudder angle.

@@ -220,13 +220,16 @@ std::shared_ptr<const Hull> voyage_hull(const std::string& name);
 /// CSV of voyage rows: the SimRow columns first (t,v,r,delta,v_true,r_true,delta_true,psi,
 /// psi_ref,fault_a,fault_g), then u,t_true,v_lf,r_lf,v_wave,r_wave,v_current,psi_meas,delta_cmd,
 /// throttle,gyro_bias,dist_v,dist_r,manoeuvre,duplicate; numbers %.17g.
+/// A measured channel whose sensor prints a number of significant digits (Quantiser::digits)
+/// is written with those digits (as its source prints it; read back it is the same double).
 class VoyageCsvWriter {
  public:
-  explicit VoyageCsvWriter(std::ostream& out);
+  explicit VoyageCsvWriter(std::ostream& out, const SensorConfig& sensors = SensorConfig{});
   void write(const VoyageRow& row);
 
  private:
   std::ostream& out_;
+  int digits_[3] = {0, 0, 0};  ///< v, r, delta; 0: %.17g
 };
 
 }  // namespace usvfdi::sim
