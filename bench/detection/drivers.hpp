@@ -1,0 +1,30 @@
+// The detectors of the detection benchmark, each run over a whole sample stream: the engine
+// as a user runs it, and the oracle (docs/benchmark.md). Every raised or cleared event is
+// acknowledged at once, so that each latch can raise again; the result is the list of alarm
+// condition changes that scoring.hpp judges.
+#pragma once
+
+#include <vector>
+
+#include "scoring.hpp"
+#include "usv_fdi/core/engine.hpp"
+
+namespace usvfdi::bench {
+
+struct MethodResult {
+  std::vector<Alarm> alarms;
+  /// First sample at which detection was live (armed, settled, learned); NaN: never.
+  double t_armed = kNaN;
+  Mat2 A_final = Mat2::Zero();
+  bool converged = false;  ///< the estimate said so at the end
+  RunScore score;          ///< filled by the caller (run_case) from the alarms
+};
+
+/// The oracle: the engine's isolation stage (Isolator + FaultLatch, default IsolationParams)
+/// given a converged Estimate with A_ref from the first sample on.
+MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2& A,
+                        const std::vector<Sample>& samples);
+/// The engine (FdiEngine) with cfg, every event acknowledged at once.
+MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samples);
+
+}  // namespace usvfdi::bench
