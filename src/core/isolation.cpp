@@ -271,9 +271,9 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   }
   if (have_prev_ && !(s.t > prev_.t)) {
     ++st_.input.rejected_time;
-    ch_[2].invalids.push_back(prev_.t);  // timing errors count against "unknown"
-    prune(&ch_[2].invalids, prev_.t - p_.spike_window);
-    const bool on = static_cast<int>(ch_[2].invalids.size()) >= p_.invalid_count;
+    timing_errors_.push_back(prev_.t);  // timing errors count against "unknown"
+    prune(&timing_errors_, prev_.t - p_.spike_window);
+    const bool on = static_cast<int>(timing_errors_.size()) >= p_.invalid_count;
     if (on) {
       set_condition(Sensor::kUnknown, kInvalid, true, FaultKind::kInvalid, prev_.t,
                     "sample timestamps repeat or go backwards", out);
@@ -369,8 +369,8 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
   st_.input.delta_ok = ok[2];
   if (std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta) last_delta_ = s.delta;
   // Timing errors age out of the unknown channel too.
-  prune(&ch_[2].invalids, s.t - p_.spike_window);
-  if ((cond_[2].sources & kInvalid) && ch_[2].invalids.empty()) {
+  prune(&timing_errors_, s.t - p_.spike_window);
+  if ((cond_[2].sources & kInvalid) && timing_errors_.empty()) {
     set_condition(Sensor::kUnknown, kInvalid, false, FaultKind::kInvalid, s.t,
                   "sample timestamps increase again", out);
   }

@@ -241,8 +241,9 @@ class Isolator {
   std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
   std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
   std::array<Channel, 3> ch_;                                    ///< v, r, delta
-  std::array<Condition, 3> cond_;                                ///< accelerometer, gyro, unknown
-  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};          ///< per sensor a/g/unknown
+  std::deque<double> timing_errors_;  ///< times of repeated / backward stamps (unknown sensor)
+  std::array<Condition, 3> cond_;     ///< accelerometer, gyro, unknown
+  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown
   std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
   std::array<double, 3> raised_at_{kNaN, kNaN, kNaN};  ///< time of the residual raise
   double last_delta_ = kNaN;
