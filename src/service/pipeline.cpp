@@ -296,13 +296,15 @@ void FdiPipeline::process(const Sample& s) {
         fmt("rudder: rudder angles again at t=%.3f s: identification and isolation resume", s.t));
   }
   recheck_restored(s);
+  const IsolatorStatus& st = iso_.status();
+  const IdentItem item{s, iso_.freeze_requested(), st.armed && !st.learning && !st.settling};
   if (opt_.lockstep) {
     std::unique_lock<std::mutex> lock(step_m_);
     ++ident_pushed_;
-    ident_q_.push(IdentItem{s, iso_.freeze_requested()});
+    ident_q_.push(item);
     step_cv_.wait(lock, [&] { return ident_done_ >= ident_pushed_; });
   } else {
-    ident_q_.push(IdentItem{s, iso_.freeze_requested()});
+    ident_q_.push(item);
   }
   bool updated = false;
   {
@@ -592,6 +594,7 @@ void FdiPipeline::identification_loop() {
     if (r == BoundedQueue<IdentItem>::PopResult::kShutdown) break;
     if (r == BoundedQueue<IdentItem>::PopResult::kTimeout) continue;
     gate_.push(it.s, it.freeze);
+    ident_.set_supervised(it.supervised);
     Sample old;
     bool freeze = false;
     bool updated = false;

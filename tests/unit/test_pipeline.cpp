@@ -187,6 +187,53 @@ TEST(FdiPipeline, PaperScenarioThroughTheThreadsRaisesBothFaults) {
   EXPECT_EQ(p.status().rejected, 0u);
 }
 
+TEST(FdiPipeline, TheDetectorSupervisesIdentificationAsInTheReplay) {
+  // GIVEN the paper's vessel and steering without faults, long enough for the detector to
+  // arm and learn
+  VesselModel v;
+  ASSERT_TRUE(find_vessel("otter", &v));
+  SimConfig sim = paper_scenario(v, 50.0, 1);
+  sim.faults.clear();  // healthy throughout
+  sim.duration = 60.0;
+  sim.sigma_v = sim.sigma_r = 0.0;
+  EngineConfig cfg;
+  cfg.B = v.B;
+  cfg.identification.eps1 = 2.0;
+  cfg.identification.settle_windows = 2;
+  cfg.identification.settle_tolerance = 0.02;
+  cfg.isolation.sigma_v = 0.005;
+  cfg.isolation.sigma_r = 0.0005;
+  cfg.isolation.settle_time = 2.0;
+  cfg.isolation.learn_time = 3.0;
+  const std::vector<SimRow> rows = simulate(sim);
+  FdiEngine engine(cfg);
+  std::vector<FaultEvent> evs;
+  for (const SimRow& r : rows) engine.process(Sample{r.t, r.v, r.r, r.delta}, &evs);
+  const IsolatorStatus& st = engine.isolation_status();
+  ASSERT_TRUE(st.armed && !st.learning && !st.settling)
+      << "the scenario must let it learn: armed " << st.armed << " learning " << st.learning
+      << " settling " << st.settling;
+  ASSERT_TRUE(engine.estimate().supervised);
+  // WHEN the same samples run through the pipeline's threads in lock-step
+  Collected c;
+  PipelineOptions opt;
+  opt.input_capacity = 1 << 16;
+  opt.input_timeout = 1e9;  // wall-clock silence must not inject samples on a busy machine
+  opt.lockstep = true;
+  FdiPipeline p = make(cfg, &c, opt);
+  p.start();
+  for (const SimRow& r : rows) {
+    p.push_rudder({r.t, r.delta, true});
+    p.push_ins({r.t, r.v, r.r, true, true});
+  }
+  p.stop();
+  // THEN its identification is supervised by its detector too (the consistency guard's
+  // release after convergence depends on it)
+  const PipelineStatus ps = p.status();
+  EXPECT_TRUE(ps.isolation.armed && !ps.isolation.learning);
+  EXPECT_TRUE(ps.estimate.supervised);
+}
+
 TEST(FdiPipeline, AcksMoveTheLatchAndStaleAcksAreRefusedWithAReason) {
   // GIVEN a pipeline whose INS gyro channel goes missing (stale) for a while
   VesselModel v;

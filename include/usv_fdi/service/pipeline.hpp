@@ -201,6 +201,7 @@ class FdiPipeline {
   struct IdentItem {
     Sample s;
     bool freeze = false;
+    bool supervised = false;  ///< the detector has learned (Identifier::set_supervised)
   };
   /// A restored active fault awaiting its re-check.
   struct Recheck {
