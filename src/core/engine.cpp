@@ -33,26 +33,12 @@ bool IdentificationGate::pop(Sample* s, bool* freeze) {
   return true;
 }
 
-FdiEngine::FdiEngine(const EngineConfig& cfg)
-    : cfg_(cfg),
-      ident_((cfg.validate(), cfg.identification), cfg.B),
-      iso_(cfg.isolation, cfg.B),
-      gate_(cfg.identification_delay) {}
+IdentificationStage::IdentificationStage(const EngineConfig& cfg)
+    : ident_((cfg.validate(), cfg.identification), cfg.B), gate_(cfg.identification_delay) {}
 
-bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
-  detections_.clear();
-  const bool accepted = iso_.update(s, &detections_);
-  // Even a rejected sample may raise a timing fault.
-  for (const Detection& d : detections_) {
-    FaultEvent ev;
-    if (latches_[static_cast<int>(d.sensor)].on_detection(d, ident_.estimate().A, &ev)) {
-      events->push_back(ev);
-    }
-  }
-  if (!accepted) return false;
-  gate_.push(s, iso_.freeze_requested());
-  const IsolatorStatus& st = iso_.status();
-  ident_.set_supervised(st.armed && !st.learning && !st.settling);
+bool IdentificationStage::push(const IdentificationInput& in) {
+  gate_.push(in.sample, in.freeze);
+  ident_.set_supervised(in.supervised);
   Sample old;
   bool freeze = false;
   bool updated = false;
@@ -61,13 +47,50 @@ bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
     ident_.update(old, freeze);
     updated = true;
   }
-  if (updated) iso_.set_estimate(ident_.estimate());
+  return updated;
+}
+
+IsolationStage::IsolationStage(const EngineConfig& cfg)
+    : iso_((cfg.validate(), cfg.isolation), cfg.B) {}
+
+bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
+                             IdentificationInput* handover) {
+  detections_.clear();
+  const bool accepted = iso_.update(s, &detections_);
+  // Even a rejected sample may raise a timing fault.
+  for (const Detection& d : detections_) {
+    FaultEvent ev;
+    if (apply(d, &ev)) events->push_back(ev);
+  }
+  if (!accepted) return false;
+  const IsolatorStatus& st = iso_.status();
+  handover->sample = s;
+  handover->freeze = iso_.freeze_requested();
+  handover->supervised = st.armed && !st.learning && !st.settling;
   return true;
 }
 
-AckResult FdiEngine::acknowledge(Sensor sensor, std::uint64_t sequence, double t,
-                                 const std::string& who, FaultEvent* event) {
+void IsolationStage::set_estimate(const Estimate& est) {
+  estimate_ = est;
+  iso_.set_estimate(estimate_);
+}
+
+bool IsolationStage::apply(const Detection& d, FaultEvent* event) {
+  return latches_[static_cast<int>(d.sensor)].on_detection(d, estimate_.A, event);
+}
+
+AckResult IsolationStage::acknowledge(Sensor sensor, std::uint64_t sequence, double t,
+                                      const std::string& who, FaultEvent* event) {
   return latches_[static_cast<int>(sensor)].acknowledge(sequence, t, who, event);
+}
+
+FdiEngine::FdiEngine(const EngineConfig& cfg) : iso_(cfg), ident_(cfg) {}
+
+bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
+  IdentificationInput handover;
+  if (!iso_.process(s, events, &handover)) return false;
+  if (ident_.push(handover)) iso_.set_estimate(ident_.estimate());
+  return true;
 }
 
 }  // namespace usvfdi

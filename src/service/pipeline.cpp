@@ -134,10 +134,9 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       input_(opt.input_capacity),
       ident_q_(opt.ident_capacity),
       output_(opt.output_capacity),
-      iso_(cfg.isolation, cfg.B),
+      iso_(cfg),
       assembler_(opt.rudder_wait, opt.rudder_timeout),
-      ident_(cfg.identification, cfg.B),
-      gate_(cfg.identification_delay) {}
+      ident_(cfg) {}
 
 FdiPipeline::~FdiPipeline() { stop(); }
 
@@ -145,7 +144,7 @@ void FdiPipeline::restore(const FaultEvent& ev) {
   if (started_) throw std::logic_error("FdiPipeline::restore() after start()");
   const int i = index_of(ev.sensor);
   if (i < 0 || i > 2) throw std::invalid_argument("FdiPipeline::restore(): unknown sensor");
-  latches_[i].restore(ev);
+  iso_.restore(ev);
   restored_.push_back(ev);
   {
     std::lock_guard<std::mutex> lock(latest_m_);
@@ -194,6 +193,7 @@ void FdiPipeline::emit(const FaultEvent& ev) {
     std::lock_guard<std::mutex> lock(latest_m_);
     latest_[index_of(ev.sensor)] = ev;
   }
+  ++events_emitted_;
   output_.push(ev);
 }
 
@@ -248,14 +248,14 @@ void FdiPipeline::accept_rudder(const RudderInput& in) {
 }
 
 void FdiPipeline::process(const Sample& s) {
-  std::vector<Detection> dets;
   const double prev_t = last_t_;
-  const bool ok = iso_.update(s, &dets);
-  for (const Detection& d : dets) {
+  events_.clear();
+  IdentificationInput handover;
+  const bool ok = iso_.process(s, &events_, &handover);
+  for (const Detection& d : iso_.detections()) {
     recheck_[index_of(d.sensor)].pending = false;  // the detector has taken the instance over
-    FaultEvent ev;
-    if (latches_[index_of(d.sensor)].on_detection(d, iso_estimate_.A, &ev)) emit(ev);
   }
+  for (const FaultEvent& ev : events_) emit(ev);
   if (!ok) {
     ++rejected_;
     problems_.example(
@@ -296,26 +296,26 @@ void FdiPipeline::process(const Sample& s) {
         fmt("rudder: rudder angles again at t=%.3f s: identification and isolation resume", s.t));
   }
   recheck_restored(s);
-  const IsolatorStatus& st = iso_.status();
-  const IdentItem item{s, iso_.freeze_requested(), st.armed && !st.learning && !st.settling};
   if (opt_.lockstep) {
     std::unique_lock<std::mutex> lock(step_m_);
     ++ident_pushed_;
-    ident_q_.push(item);
+    ident_q_.push(handover);
     step_cv_.wait(lock, [&] { return ident_done_ >= ident_pushed_; });
   } else {
-    ident_q_.push(item);
+    ident_q_.push(handover);
   }
-  bool updated = false;
+  take_estimate();
+}
+
+void FdiPipeline::take_estimate() {
+  Estimate est;
   {
     std::lock_guard<std::mutex> lock(snap_m_);
-    if (snapshot_version_ != seen_version_) {
-      iso_estimate_ = snapshot_;
-      seen_version_ = snapshot_version_;
-      updated = true;
-    }
+    if (snapshot_version_ == seen_version_) return;
+    est = snapshot_;
+    seen_version_ = snapshot_version_;
   }
-  if (updated) iso_.set_estimate(iso_estimate_);
+  iso_.set_estimate(est);
 }
 
 void FdiPipeline::recheck_restored(const Sample& s) {
@@ -351,7 +351,7 @@ void FdiPipeline::recheck_restored(const Sample& s) {
     d.threshold = i < 2 ? st.thresholds(i) : st.threshold;
     d.message = "not present after the restart: " + why + fmt(" %.1f s", opt_.restore_recheck);
     FaultEvent ev;
-    if (latches_[i].on_detection(d, iso_estimate_.A, &ev)) {
+    if (iso_.apply(d, &ev)) {
       log(1, std::string("restored ") + to_string(d.sensor) + " fault (" + to_string(rc.kind) +
                  ") " + d.message + ": now #" + std::to_string(ev.sequence) + " " +
                  to_string(ev.state));
@@ -373,11 +373,11 @@ void FdiPipeline::handle_ack(const AckInput& a) {
     log(2, "ack refused: unknown sensor " + std::to_string(static_cast<int>(a.sensor)));
     return;
   }
-  FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
+  const FaultLatch& latch = iso_.latch(a.sensor);
   const std::uint64_t current = latch.current().sequence;
   // Stamp: the time of the last sample (before any sample after a restart: the event's own).
   const double t = std::isfinite(last_t_) ? last_t_ : latch.current().t;
-  const AckResult r = latch.acknowledge(a.sequence, t, a.who, &ev);
+  const AckResult r = iso_.acknowledge(a.sensor, a.sequence, t, a.who, &ev);
   if (r == AckResult::kAccepted) {
     log(1, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
                " by " + a.who + " accepted");
@@ -392,7 +392,7 @@ void FdiPipeline::handle_ack(const AckInput& a) {
 PipelineStatus FdiPipeline::make_status() {
   PipelineStatus st;
   st.stamp = last_t_;
-  st.estimate = iso_estimate_;
+  st.estimate = iso_.estimate();
   st.isolation = iso_.status();
   st.samples = samples_.load();
   st.rejected = rejected_.load();
@@ -553,6 +553,7 @@ void FdiPipeline::isolation_loop() {
       batch.clear();
       assembler_.drain(&batch);
       for (const Sample& s : batch) process(s);
+      ++inputs_handled_;
     }
     if (had_ins_ && !ins_silent_ && seconds(now - last_ins) > opt_.input_timeout) {
       ins_silent_ = true;
@@ -585,25 +586,16 @@ void FdiPipeline::isolation_loop() {
 }
 
 void FdiPipeline::identification_loop() {
-  IdentItem it;
-  double last_snapshot = -1e300;
+  IdentificationInput it;
   bool last_converged = false;
   for (;;) {
     beat_ident_.store(now_ns(), std::memory_order_relaxed);
     const auto r = ident_q_.pop_for(&it, std::chrono::milliseconds(100));
-    if (r == BoundedQueue<IdentItem>::PopResult::kShutdown) break;
-    if (r == BoundedQueue<IdentItem>::PopResult::kTimeout) continue;
-    gate_.push(it.s, it.freeze);
-    ident_.set_supervised(it.supervised);
-    Sample old;
-    bool freeze = false;
-    bool updated = false;
-    while (gate_.pop(&old, &freeze)) {
-      ident_.update(old, freeze);
-      updated = true;
-    }
-    const Estimate& e = ident_.estimate();
-    if (updated && (e.t - last_snapshot >= opt_.snapshot_period || e.converged != last_converged)) {
+    if (r == BoundedQueue<IdentificationInput>::PopResult::kShutdown) break;
+    if (r == BoundedQueue<IdentificationInput>::PopResult::kTimeout) continue;
+    // Every new estimate goes to the isolation thread, as in FdiEngine.
+    if (ident_.push(it)) {
+      const Estimate& e = ident_.estimate();
       if (e.converged != last_converged) {
         const Mat2& A = e.A;
         char buf[200];
@@ -619,7 +611,6 @@ void FdiPipeline::identification_loop() {
         snapshot_ = e;
         ++snapshot_version_;
       }
-      last_snapshot = e.t;
       last_converged = e.converged;
     }
     if (opt_.lockstep) {

@@ -1,6 +1,9 @@
-// The whole FDI pipeline in one thread, sample by sample (replay, tests, benchmark).
-// The DDS service runs the same pieces in two threads: Identifier in the identification
-// thread, Isolator + FaultLatch in the isolation thread.
+// The FDI engine as two stages with one wiring between them: the isolation stage (Isolator
+// and the fault latches) hands every accepted sample to the identification stage with its
+// freeze request and supervision flag (IdentificationInput); the identification stage (the
+// delay gate and the Identifier) hands every new estimate back. FdiEngine runs them in
+// sequence in one thread (replay, tests, benchmark); the service's pipeline runs each in a
+// thread of its own (src/service/pipeline.cpp).
 #pragma once
 
 #include <array>
@@ -41,6 +44,67 @@ class IdentificationGate {
   double newest_t_ = -1e300;
 };
 
+/// The one wiring from the isolation stage to the identification stage, handed over with
+/// every sample the isolation stage accepted.
+struct IdentificationInput {
+  Sample sample;
+  bool freeze = false;      ///< the detector suspects the data (Isolator::freeze_requested)
+  bool supervised = false;  ///< the detector is armed and has learned (set_supervised)
+};
+
+/// Identification (the identification thread's part): the delay gate and the DREM
+/// estimator. Each estimate it produces goes back to the isolation stage (set_estimate).
+class IdentificationStage {
+ public:
+  explicit IdentificationStage(const EngineConfig& cfg);
+  /// Takes one hand-over and feeds the estimator every sample the gate releases. Returns
+  /// true when the estimate changed (hand it to IsolationStage::set_estimate).
+  bool push(const IdentificationInput& in);
+  const Estimate& estimate() const { return ident_.estimate(); }
+  const Identifier& identifier() const { return ident_; }
+  std::uint64_t frozen_samples() const { return frozen_samples_; }
+
+ private:
+  Identifier ident_;
+  IdentificationGate gate_;
+  std::uint64_t frozen_samples_ = 0;
+};
+
+/// Detection, isolation and the fault latches (the isolation thread's part), with the
+/// estimate of A in force.
+class IsolationStage {
+ public:
+  explicit IsolationStage(const EngineConfig& cfg);
+  /// Processes one sample; appends latched-state changes to events. Returns false when the
+  /// sample was rejected (its time did not increase); else fills *handover.
+  bool process(const Sample& s, std::vector<FaultEvent>* events, IdentificationInput* handover);
+  /// Installs an estimate the identification stage produced.
+  void set_estimate(const Estimate& est);
+  /// Latches a change of condition found outside the detector (a restored fault's
+  /// re-check). Returns true and fills *event when the latched state changed.
+  bool apply(const Detection& d, FaultEvent* event);
+  AckResult acknowledge(Sensor sensor, std::uint64_t sequence, double t, const std::string& who,
+                        FaultEvent* event);
+  /// Restores a persisted event (restart without loss).
+  void restore(const FaultEvent& ev) { latches_[static_cast<int>(ev.sensor)].restore(ev); }
+
+  /// The detections of the last process() call (before latching).
+  const std::vector<Detection>& detections() const { return detections_; }
+  const Estimate& estimate() const { return estimate_; }
+  const Isolator& isolator() const { return iso_; }
+  const IsolatorStatus& status() const { return iso_.status(); }
+  bool freeze_requested() const { return iso_.freeze_requested(); }
+  const FaultLatch& latch(Sensor s) const { return latches_[static_cast<int>(s)]; }
+
+ private:
+  Isolator iso_;
+  Estimate estimate_;  ///< in force (its A goes into every event)
+  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
+                                     FaultLatch(Sensor::kUnknown)};
+  std::vector<Detection> detections_;
+};
+
+/// Both stages in one thread, in sequence (replay, tests, benchmark).
 class FdiEngine {
  public:
   explicit FdiEngine(const EngineConfig& cfg);
@@ -50,23 +114,19 @@ class FdiEngine {
   bool process(const Sample& s, std::vector<FaultEvent>* events);
 
   AckResult acknowledge(Sensor sensor, std::uint64_t sequence, double t, const std::string& who,
-                        FaultEvent* event);
+                        FaultEvent* event) {
+    return iso_.acknowledge(sensor, sequence, t, who, event);
+  }
 
   const Estimate& estimate() const { return ident_.estimate(); }
   const IsolatorStatus& isolation_status() const { return iso_.status(); }
-  const FaultLatch& latch(Sensor s) const { return latches_[static_cast<int>(s)]; }
-  const Identifier& identifier() const { return ident_; }
-  std::uint64_t frozen_samples() const { return frozen_samples_; }
+  const FaultLatch& latch(Sensor s) const { return iso_.latch(s); }
+  const Identifier& identifier() const { return ident_.identifier(); }
+  std::uint64_t frozen_samples() const { return ident_.frozen_samples(); }
 
  private:
-  EngineConfig cfg_;
-  Identifier ident_;
-  Isolator iso_;
-  IdentificationGate gate_;
-  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
-                                     FaultLatch(Sensor::kUnknown)};
-  std::vector<Detection> detections_;
-  std::uint64_t frozen_samples_ = 0;
+  IsolationStage iso_;
+  IdentificationStage ident_;
 };
 
 }  // namespace usvfdi

@@ -81,7 +81,6 @@ struct PipelineOptions {
   double rudder_timeout = 0.5;         ///< [s, source time]
   double input_timeout = 1.0;          ///< INS silent this long (wall clock): stale [s]
   double status_period = 1.0;          ///< FdiStatus period (wall clock) [s]
-  double snapshot_period = 0.2;        ///< estimate snapshots (source time) [s]
   /// A fault restored at start (raised or active-acknowledged) whose sensor-level condition
   /// (stale, stuck, invalid) is no longer seen for this long is cleared [s, source time];
   /// a residual fault once the re-armed detector has learned and sees none.
@@ -192,17 +191,18 @@ class FdiPipeline {
   bool push_ack(const AckInput& a) { return input_.push(a); }
 
   PipelineStatus status() const;
+  /// Inputs (INS, rudder, acks) the isolation thread has handled, and the events it has
+  /// handed to the publisher since start. A caller that pushes one sample, waits for the
+  /// first and for its sink to have received the second, sees each sample's events before
+  /// the next sample is processed (an operator's ack then lands where replay puts it).
+  std::uint64_t inputs_handled() const { return inputs_handled_.load(); }
+  std::uint64_t events_emitted() const { return events_emitted_.load(); }
   /// For a health check: how recently each thread went round its loop.
   PipelineLiveness liveness() const;
 
  private:
   using Input = std::variant<InsInput, RudderInput, AckInput>;
   using Output = std::variant<FaultEvent, PipelineStatus>;
-  struct IdentItem {
-    Sample s;
-    bool freeze = false;
-    bool supervised = false;  ///< the detector has learned (Identifier::set_supervised)
-  };
   /// A restored active fault awaiting its re-check.
   struct Recheck {
     bool pending = false;
@@ -240,6 +240,8 @@ class FdiPipeline {
   void accept_ins(const InsInput& in);
   void accept_rudder(const RudderInput& in);
   void process(const Sample& s);
+  /// Installs the identification thread's latest estimate, if there is a new one.
+  void take_estimate();
   void recheck_restored(const Sample& s);
   void emit(const FaultEvent& ev);
   void publish(const FaultEvent& ev);
@@ -256,20 +258,18 @@ class FdiPipeline {
   LogSink on_log_;
 
   BoundedQueue<Input> input_;
-  BoundedQueue<IdentItem> ident_q_;
+  BoundedQueue<IdentificationInput> ident_q_;
   BoundedQueue<Output> output_;
 
   // Isolation thread state.
-  Isolator iso_;
-  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
-                                     FaultLatch(Sensor::kUnknown)};
+  IsolationStage iso_;
+  std::vector<FaultEvent> events_;  ///< of the sample being processed
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
   std::array<Recheck, 3> recheck_{};
   double last_t_ = kNaN;
   double newest_ins_stamp_ = -1e300;
   std::uint64_t seen_version_ = 0;
-  Estimate iso_estimate_;
   InputProblems problems_;
   ProblemCounts logged_;        ///< counts at the previous status (per-period flags, log)
   bool rudder_paused_ = false;  ///< logged state of the rudder pause
@@ -279,8 +279,7 @@ class FdiPipeline {
   std::chrono::steady_clock::time_point started_at_{};
 
   // Identification thread state.
-  Identifier ident_;
-  IdentificationGate gate_;
+  IdentificationStage ident_;
 
   // Shared, under snap_m_.
   mutable std::mutex snap_m_;
@@ -296,6 +295,7 @@ class FdiPipeline {
   std::array<std::uint64_t, 3> published_seq_{0, 0, 0};
 
   std::atomic<std::uint64_t> samples_{0}, rejected_{0};
+  std::atomic<std::uint64_t> inputs_handled_{0}, events_emitted_{0};
   // Lockstep bookkeeping, under step_m_.
   std::mutex step_m_;
   std::condition_variable step_cv_;
