@@ -15,8 +15,36 @@ void EngineConfig::validate() const {
     throw std::invalid_argument("identification.delay = " + std::to_string(identification_delay) +
                                 ": must be >= 0");
   }
+  if (!(clock_max_jump > 0) || !std::isfinite(clock_max_jump)) {
+    throw std::invalid_argument("clock.max_jump = " + std::to_string(clock_max_jump) +
+                                ": must be > 0 and finite");
+  }
+  if (clock_confirm_samples < 2) {
+    throw std::invalid_argument("clock.confirm_samples = " + std::to_string(clock_confirm_samples) +
+                                ": must be >= 2");
+  }
   identification.validate();
   isolation.validate();
+}
+
+SampleClock::Verdict SampleClock::check(double t) {
+  if (std::isnan(last_) || follows(t, last_)) {
+    last_ = t;
+    candidate_count_ = 0;
+    return Verdict::kAccept;
+  }
+  if (candidate_count_ > 0 && follows(t, candidate_last_)) {
+    ++candidate_count_;
+  } else {
+    candidate_count_ = 1;
+  }
+  candidate_last_ = t;
+  if (candidate_count_ < confirm_) return Verdict::kReject;
+  resync_from_ = last_;
+  last_ = t;
+  candidate_count_ = 0;
+  ++resyncs_;
+  return Verdict::kResync;
 }
 
 void IdentificationGate::push(const Sample& s, bool freeze_requested) {
@@ -34,9 +62,21 @@ bool IdentificationGate::pop(Sample* s, bool* freeze) {
 }
 
 IdentificationStage::IdentificationStage(const EngineConfig& cfg)
-    : ident_((cfg.validate(), cfg.identification), cfg.B), gate_(cfg.identification_delay) {}
+    : params_((cfg.validate(), cfg.identification)),
+      B_(cfg.B),
+      delay_(cfg.identification_delay),
+      ident_(params_, B_),
+      gate_(delay_) {}
 
 bool IdentificationStage::push(const IdentificationInput& in) {
+  if (in.restart) {
+    // A new time base: the filters, memories and the samples waiting in the gate belong to
+    // the old one. The estimator starts afresh from the estimate it had.
+    IdentificationParams p = params_;
+    p.a0 = to_params(ident_.estimate().A);
+    ident_ = Identifier(p, B_);
+    gate_ = IdentificationGate(delay_);
+  }
   gate_.push(in.sample, in.freeze);
   ident_.set_supervised(in.supervised);
   Sample old;
@@ -51,12 +91,27 @@ bool IdentificationStage::push(const IdentificationInput& in) {
 }
 
 IsolationStage::IsolationStage(const EngineConfig& cfg)
-    : iso_((cfg.validate(), cfg.isolation), cfg.B) {}
+    : params_((cfg.validate(), cfg.isolation)),
+      B_(cfg.B),
+      clock_(cfg.clock_max_jump, cfg.clock_confirm_samples),
+      iso_(params_, B_) {}
+
+void IsolationStage::restart(const Sample& s) {
+  iso_ = Isolator(params_, B_);
+  estimate_ = Estimate{};
+  estimate_.t = s.t;
+}
 
 bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
                              IdentificationInput* handover) {
   detections_.clear();
-  const bool accepted = iso_.update(s, &detections_);
+  SampleClock::Verdict verdict = SampleClock::Verdict::kAccept;
+  if (std::isfinite(s.t)) verdict = clock_.check(s.t);
+  if (verdict == SampleClock::Verdict::kResync) restart(s);
+  const bool accepted = verdict == SampleClock::Verdict::kReject
+                            ? iso_.reject_timestamp(&detections_)
+                            : iso_.update(s, &detections_);
+  if (!accepted) ++rejected_;
   // Even a rejected sample may raise a timing fault.
   for (const Detection& d : detections_) {
     FaultEvent ev;
@@ -67,6 +122,7 @@ bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
   handover->sample = s;
   handover->freeze = iso_.freeze_requested();
   handover->supervised = st.armed && !st.learning && !st.settling;
+  handover->restart = verdict == SampleClock::Verdict::kResync;
   return true;
 }
 

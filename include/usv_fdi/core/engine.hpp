@@ -23,9 +23,40 @@ struct EngineConfig {
   /// Identification consumes samples this much later than isolation, so that a fault
   /// detected within the delay never reaches the estimator [s].
   double identification_delay = 0.5;
+  /// A stamp that goes back, repeats, or jumps ahead by more than this does not belong to
+  /// the current time base: rejected alone, or adopted as a new base (SampleClock) [s].
+  double clock_max_jump = 60.0;
+  /// Consecutive samples consistent among themselves in a new time base that adopt it.
+  int clock_confirm_samples = 5;
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
+};
+
+/// The source clock's time base. A stamp after the last accepted one by at most max_jump
+/// is accepted. Any other (repeated, backward, far ahead) is rejected alone, unless it
+/// starts a run of confirm_samples stamps that increase by at most max_jump each: that run
+/// is a new time base (an INS clock that restarted at 0 or was re-set), adopted on its
+/// last sample: the stages restart their filters on it. Constant memory.
+class SampleClock {
+ public:
+  enum class Verdict : std::uint8_t { kAccept, kReject, kResync };
+  SampleClock(double max_jump, int confirm) : max_jump_(max_jump), confirm_(confirm) {}
+  Verdict check(double t);
+  double last() const { return last_; }
+  std::uint64_t resyncs() const { return resyncs_; }
+  /// The time base left at the latest re-synchronisation: its last stamp [s].
+  double resync_from() const { return resync_from_; }
+
+ private:
+  bool follows(double t, double after) const { return t > after && t - after <= max_jump_; }
+  double max_jump_;
+  int confirm_;
+  double last_ = kNaN;
+  double candidate_last_ = kNaN;
+  int candidate_count_ = 0;
+  std::uint64_t resyncs_ = 0;
+  double resync_from_ = kNaN;
 };
 
 /// Holds samples for the identification thread and decides which to freeze: a sample of
@@ -50,6 +81,7 @@ struct IdentificationInput {
   Sample sample;
   bool freeze = false;      ///< the detector suspects the data (Isolator::freeze_requested)
   bool supervised = false;  ///< the detector is armed and has learned (set_supervised)
+  bool restart = false;     ///< a new time base begins with this sample (SampleClock)
 };
 
 /// Identification (the identification thread's part): the delay gate and the DREM
@@ -65,6 +97,9 @@ class IdentificationStage {
   std::uint64_t frozen_samples() const { return frozen_samples_; }
 
  private:
+  IdentificationParams params_;
+  Vec2 B_;
+  double delay_;
   Identifier ident_;
   IdentificationGate gate_;
   std::uint64_t frozen_samples_ = 0;
@@ -95,8 +130,19 @@ class IsolationStage {
   const IsolatorStatus& status() const { return iso_.status(); }
   bool freeze_requested() const { return iso_.freeze_requested(); }
   const FaultLatch& latch(Sensor s) const { return latches_[static_cast<int>(s)]; }
+  const SampleClock& clock() const { return clock_; }
+  /// Samples rejected for their stamp (not finite, or outside the time base).
+  std::uint64_t rejected_samples() const { return rejected_; }
 
  private:
+  /// A new time base: the detector starts afresh (its windows, observers and learned
+  /// statistics belong to the old one); the latches keep their events and sequences.
+  void restart(const Sample& s);
+
+  IsolationParams params_;
+  Vec2 B_;
+  SampleClock clock_;
+  std::uint64_t rejected_ = 0;
   Isolator iso_;
   Estimate estimate_;  ///< in force (its A goes into every event)
   std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
@@ -123,6 +169,9 @@ class FdiEngine {
   const FaultLatch& latch(Sensor s) const { return iso_.latch(s); }
   const Identifier& identifier() const { return ident_.identifier(); }
   std::uint64_t frozen_samples() const { return ident_.frozen_samples(); }
+  /// Samples rejected for their stamp, and re-synchronisations of the time base.
+  std::uint64_t rejected_samples() const { return iso_.rejected_samples(); }
+  std::uint64_t clock_resyncs() const { return iso_.clock().resyncs(); }
 
  private:
   IsolationStage iso_;

@@ -140,6 +140,9 @@ class Isolator {
   /// Processes one sample; appends every change of a sensor's fault condition to out.
   /// Returns false when the sample was rejected (time did not increase).
   bool update(const Sample& s, std::vector<Detection>* out);
+  /// A sample whose stamp does not fit the time base (repeated, backward, or far ahead):
+  /// counted, and against the unknown sensor's invalid condition. Returns false.
+  bool reject_timestamp(std::vector<Detection>* out);
 
   /// True while identification must not learn from the data (fault suspected or active,
   /// inputs unusable, or within resume_time of that).
