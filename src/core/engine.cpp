@@ -71,10 +71,8 @@ IdentificationStage::IdentificationStage(const EngineConfig& cfg)
 bool IdentificationStage::push(const IdentificationInput& in) {
   if (in.restart) {
     // A new time base: the filters, memories and the samples waiting in the gate belong to
-    // the old one. The estimator starts afresh from the estimate it had.
-    IdentificationParams p = params_;
-    p.a0 = to_params(ident_.estimate().A);
-    ident_ = Identifier(p, B_);
+    // the old one. The estimator starts afresh, as at start-up.
+    ident_ = Identifier(params_, B_);
     gate_ = IdentificationGate(delay_);
   }
   gate_.push(in.sample, in.freeze);

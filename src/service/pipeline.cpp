@@ -18,7 +18,10 @@ void SampleAssembler::add_ins(const InsInput& s) {
   auto it = ins_.end();
   while (it != ins_.begin() && std::prev(it)->stamp > s.stamp) --it;
   ins_.insert(it, s);
-  newest_ins_ = std::max(newest_ins_, s.stamp);
+  // Far behind the newest (an INS clock that restarted): the newest of the old time base
+  // must not hold back, nor prune the rudder samples of, the new one.
+  newest_ins_ =
+      s.stamp < newest_ins_ - (wait_ + timeout_) ? s.stamp : std::max(newest_ins_, s.stamp);
 }
 
 void SampleAssembler::add_rudder(const RudderInput& s) {
@@ -54,6 +57,17 @@ double SampleAssembler::delta_at(double t) const {
   }
   const RudderInput& last = rudder_.back();
   return t - last.stamp <= timeout_ ? last.delta : kNaN;
+}
+
+void SampleAssembler::rebase(double t, double span) {
+  const auto far = [t, span](double stamp) { return std::abs(stamp - t) > span; };
+  ins_.erase(
+      std::remove_if(ins_.begin(), ins_.end(), [&](const InsInput& s) { return far(s.stamp); }),
+      ins_.end());
+  rudder_.erase(std::remove_if(rudder_.begin(), rudder_.end(),
+                               [&](const RudderInput& s) { return far(s.stamp); }),
+                rudder_.end());
+  if (far(newest_ins_)) newest_ins_ = ins_.empty() ? t : ins_.back().stamp;
 }
 
 void SampleAssembler::drain(std::vector<Sample>* out, bool flush) {
@@ -256,6 +270,16 @@ void FdiPipeline::process(const Sample& s) {
     recheck_[index_of(d.sensor)].pending = false;  // the detector has taken the instance over
   }
   for (const FaultEvent& ev : events_) emit(ev);
+  const bool resynced = iso_.clock().resyncs() != resyncs_seen_;
+  if (resynced) {
+    resyncs_seen_ = iso_.clock().resyncs();
+    log(2, fmt("INS clock re-synchronised: stamps left the time base at t=%.3f s and continue "
+               "consistently from t=%.3f s: detection and identification restarted",
+               iso_.clock().resync_from(), s.t));
+  }
+  if (!ok || resynced) {
+    assembler_.rebase(iso_.clock().last(), cfg_.clock_max_jump);
+  }
   if (!ok) {
     ++rejected_;
     problems_.example(
@@ -396,6 +420,7 @@ PipelineStatus FdiPipeline::make_status() {
   st.isolation = iso_.status();
   st.samples = samples_.load();
   st.rejected = rejected_.load();
+  st.clock_resyncs = iso_.clock().resyncs();
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
   st.dropped_output = output_.dropped() + dropped_at_stop_.load();

@@ -64,6 +64,10 @@ class SampleAssembler {
   /// Appends the samples that are ready; flush = true releases everything.
   void drain(std::vector<Sample>* out, bool flush = false);
   std::size_t pending() const { return ins_.size(); }
+  /// The engine's time base is now at t (it re-synchronised, or rejected a stamp): samples
+  /// more than span away from it are dropped, so that they neither hold the others back
+  /// nor push the new base's rudder samples out.
+  void rebase(double t, double span);
 
  private:
   double delta_at(double t) const;
@@ -135,7 +139,8 @@ struct PipelineStatus {
   std::uint64_t dropped_inputs = 0;  ///< input queue overflow
   std::uint64_t dropped_ident = 0;   ///< identification queue overflow
   std::uint64_t dropped_output = 0;  ///< output queue overflow, and events left at stop()
-  std::uint64_t rejected = 0;        ///< samples the engine refused (time not increasing)
+  std::uint64_t rejected = 0;        ///< samples the engine refused for their stamp
+  std::uint64_t clock_resyncs = 0;   ///< new time bases adopted (the engine restarted on each)
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
   // Input problems, counted since start (see InputFlag for the per-period flags).
@@ -264,6 +269,7 @@ class FdiPipeline {
   // Isolation thread state.
   IsolationStage iso_;
   std::vector<FaultEvent> events_;  ///< of the sample being processed
+  std::uint64_t resyncs_seen_ = 0;  ///< clock re-synchronisations logged
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
   std::array<Recheck, 3> recheck_{};
