@@ -109,3 +109,52 @@ TEST(SourceClock, AClockThatStandsStillIsRejectedSampleBySampleAndCounted) {
 
 }  // namespace
 }  // namespace usvfdi::scenario
+
+namespace usvfdi::scenario {
+namespace {
+
+/// Raises of a healthy 10 Hz Otter voyage (shipped config) with the samples in
+/// [from, from + length) removed.
+std::vector<FaultEvent> healthy_with_gap(double from, double length, std::uint64_t seed) {
+  std::vector<Sample> samples;
+  for (const SimRow& r : voyage(400.0, seed, false)) {
+    if (r.t >= from && r.t < from + length) continue;
+    samples.push_back({r.t, r.v, r.r, r.delta});
+  }
+  FdiEngine engine(io::load_engine_config(kSource + "/config/vessels/otter.yaml"));
+  std::vector<FaultEvent> events, raises;
+  for (const Sample& s : samples) {
+    events.clear();
+    engine.process(s, &events);
+    for (const FaultEvent& e : events) {
+      if (is_raise(e)) raises.push_back(e);
+    }
+  }
+  return raises;
+}
+
+// Issue 15, item 11, NOT FIXED YET (disabled: it fails). Found so far: every gap length
+// tried (0.3-20 s) gives false gyro bias/drift raises about 7-8 s after the gap, i.e. just
+// after the observers' settle_time (6 s) following their restart at the gap; with
+// isolation.settle_time = 20 s none are raised. Freezing identification across the gap
+// and restarting the observers and windows at every gap of more than 2.5 sample
+// intervals did not remove them. Run with --gtest_also_run_disabled_tests.
+TEST(InputGap, DISABLED_ABlockOfMissingSamplesInAHealthyVoyageRaisesNothing) {
+  // GIVEN healthy voyages with gaps of 0.3 s to 20 s after the detector has learned
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    for (double length : {0.3, 0.45, 0.8, 2.0, 5.0, 20.0}) {
+      for (double from : {200.0, 260.3, 320.7}) {
+        SCOPED_TRACE("seed " + std::to_string(seed) + ", gap of " + std::to_string(length) +
+                     " s at " + std::to_string(from) + " s");
+        // WHEN they are replayed THEN no fault is raised
+        for (const FaultEvent& e : healthy_with_gap(from, length, seed)) {
+          ADD_FAILURE() << to_string(e.sensor) << " " << to_string(e.kind) << " raised at " << e.t
+                        << ": " << e.message;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace usvfdi::scenario
