@@ -112,7 +112,7 @@ int run_replay(const ReplayArgs& a) {
   }
   for (const std::string& w : sum.warnings) spdlog::warn("{}: {}", a.input, w);
   if (code == kExitOk) code = report_rejections(a.input, sum);
-  if (code == kExitOk && !sum.not_converged.empty()) {
+  if ((code == kExitOk || code == kExitRejected) && !sum.not_converged.empty()) {
     spdlog::warn(
         "{}: after {:.1f} s of data the estimate of A has {} (detection is armed only "
         "after convergence)",

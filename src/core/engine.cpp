@@ -15,8 +15,36 @@ void EngineConfig::validate() const {
     throw std::invalid_argument("identification.delay = " + std::to_string(identification_delay) +
                                 ": must be >= 0");
   }
+  if (!(clock_max_jump > 0) || !std::isfinite(clock_max_jump)) {
+    throw std::invalid_argument("clock.max_jump = " + std::to_string(clock_max_jump) +
+                                ": must be > 0 and finite");
+  }
+  if (clock_confirm_samples < 2) {
+    throw std::invalid_argument("clock.confirm_samples = " + std::to_string(clock_confirm_samples) +
+                                ": must be >= 2");
+  }
   identification.validate();
   isolation.validate();
+}
+
+SampleClock::Verdict SampleClock::check(double t) {
+  if (std::isnan(last_) || follows(t, last_)) {
+    last_ = t;
+    candidate_count_ = 0;
+    return Verdict::kAccept;
+  }
+  if (candidate_count_ > 0 && follows(t, candidate_last_)) {
+    ++candidate_count_;
+  } else {
+    candidate_count_ = 1;
+  }
+  candidate_last_ = t;
+  if (candidate_count_ < confirm_) return Verdict::kReject;
+  resync_from_ = last_;
+  last_ = t;
+  candidate_count_ = 0;
+  ++resyncs_;
+  return Verdict::kResync;
 }
 
 void IdentificationGate::push(const Sample& s, bool freeze_requested) {
@@ -33,26 +61,22 @@ bool IdentificationGate::pop(Sample* s, bool* freeze) {
   return true;
 }
 
-FdiEngine::FdiEngine(const EngineConfig& cfg)
-    : cfg_(cfg),
-      ident_((cfg.validate(), cfg.identification), cfg.B),
-      iso_(cfg.isolation, cfg.B),
-      gate_(cfg.identification_delay) {}
+IdentificationStage::IdentificationStage(const EngineConfig& cfg)
+    : params_((cfg.validate(), cfg.identification)),
+      B_(cfg.B),
+      delay_(cfg.identification_delay),
+      ident_(params_, B_),
+      gate_(delay_) {}
 
-bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
-  detections_.clear();
-  const bool accepted = iso_.update(s, &detections_);
-  // Even a rejected sample may raise a timing fault.
-  for (const Detection& d : detections_) {
-    FaultEvent ev;
-    if (latches_[static_cast<int>(d.sensor)].on_detection(d, ident_.estimate().A, &ev)) {
-      events->push_back(ev);
-    }
+bool IdentificationStage::push(const IdentificationInput& in) {
+  if (in.restart) {
+    // A new time base: the filters, memories and the samples waiting in the gate belong to
+    // the old one. The estimator starts afresh, as at start-up.
+    ident_ = Identifier(params_, B_);
+    gate_ = IdentificationGate(delay_);
   }
-  if (!accepted) return false;
-  gate_.push(s, iso_.freeze_requested());
-  const IsolatorStatus& st = iso_.status();
-  ident_.set_supervised(st.armed && !st.learning && !st.settling);
+  gate_.push(in.sample, in.freeze);
+  ident_.set_supervised(in.supervised);
   Sample old;
   bool freeze = false;
   bool updated = false;
@@ -61,13 +85,66 @@ bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
     ident_.update(old, freeze);
     updated = true;
   }
-  if (updated) iso_.set_estimate(ident_.estimate());
+  return updated;
+}
+
+IsolationStage::IsolationStage(const EngineConfig& cfg)
+    : params_((cfg.validate(), cfg.isolation)),
+      B_(cfg.B),
+      clock_(cfg.clock_max_jump, cfg.clock_confirm_samples),
+      iso_(params_, B_) {}
+
+void IsolationStage::restart(const Sample& s) {
+  iso_ = Isolator(params_, B_);
+  estimate_ = Estimate{};
+  estimate_.t = s.t;
+}
+
+bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
+                             IdentificationInput* handover) {
+  detections_.clear();
+  SampleClock::Verdict verdict = SampleClock::Verdict::kAccept;
+  if (std::isfinite(s.t)) verdict = clock_.check(s.t);
+  if (verdict == SampleClock::Verdict::kResync) restart(s);
+  const bool accepted = verdict == SampleClock::Verdict::kReject
+                            ? iso_.reject_timestamp(&detections_)
+                            : iso_.update(s, &detections_);
+  if (!accepted) ++rejected_;
+  // Even a rejected sample may raise a timing fault.
+  for (const Detection& d : detections_) {
+    FaultEvent ev;
+    if (apply(d, &ev)) events->push_back(ev);
+  }
+  if (!accepted) return false;
+  const IsolatorStatus& st = iso_.status();
+  handover->sample = s;
+  handover->freeze = iso_.freeze_requested();
+  handover->supervised = st.armed && !st.learning && !st.settling;
+  handover->restart = verdict == SampleClock::Verdict::kResync;
   return true;
 }
 
-AckResult FdiEngine::acknowledge(Sensor sensor, std::uint64_t sequence, double t,
-                                 const std::string& who, FaultEvent* event) {
+void IsolationStage::set_estimate(const Estimate& est) {
+  estimate_ = est;
+  iso_.set_estimate(estimate_);
+}
+
+bool IsolationStage::apply(const Detection& d, FaultEvent* event) {
+  return latches_[static_cast<int>(d.sensor)].on_detection(d, estimate_.A, event);
+}
+
+AckResult IsolationStage::acknowledge(Sensor sensor, std::uint64_t sequence, double t,
+                                      const std::string& who, FaultEvent* event) {
   return latches_[static_cast<int>(sensor)].acknowledge(sequence, t, who, event);
+}
+
+FdiEngine::FdiEngine(const EngineConfig& cfg) : iso_(cfg), ident_(cfg) {}
+
+bool FdiEngine::process(const Sample& s, std::vector<FaultEvent>* events) {
+  IdentificationInput handover;
+  if (!iso_.process(s, events, &handover)) return false;
+  if (ident_.push(handover)) iso_.set_estimate(ident_.estimate());
+  return true;
 }
 
 }  // namespace usvfdi

@@ -269,19 +269,7 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
     ++st_.input.invalid_values;
     return false;
   }
-  if (have_prev_ && !(s.t > prev_.t)) {
-    ++st_.input.rejected_time;
-    ch_[2].invalids.push_back(prev_.t);  // timing errors count against "unknown"
-    prune(&ch_[2].invalids, prev_.t - p_.spike_window);
-    const bool on = static_cast<int>(ch_[2].invalids.size()) >= p_.invalid_count;
-    if (on) {
-      set_condition(Sensor::kUnknown, kInvalid, true, FaultKind::kInvalid, prev_.t,
-                    "sample timestamps repeat or go backwards", out);
-    }
-    t_last_suspect_ = prev_.t;
-    freeze_ = true;
-    return false;
-  }
+  if (have_prev_ && !(s.t > prev_.t)) return reject_timestamp(out);
   const double dt = have_prev_ ? s.t - prev_.t : 0.0;
   ++st_.samples;
   if (have_prev_ && dt > p_.stale_timeout) ++st_.input.gaps;
@@ -304,6 +292,23 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   prev_ = s;
   have_prev_ = true;
   return true;
+}
+
+bool Isolator::reject_timestamp(std::vector<Detection>* out) {
+  ++st_.input.rejected_time;
+  if (!have_prev_) return false;
+  // Timing errors count against "unknown", at the last good time (the clock stands still
+  // while stamps are bad: only the latest invalid_count are needed, memory stays bounded).
+  timing_errors_.push_back(prev_.t);
+  prune(&timing_errors_, prev_.t - p_.spike_window);
+  while (static_cast<int>(timing_errors_.size()) > p_.invalid_count) timing_errors_.pop_front();
+  if (static_cast<int>(timing_errors_.size()) >= p_.invalid_count) {
+    set_condition(Sensor::kUnknown, kInvalid, true, FaultKind::kInvalid, prev_.t,
+                  "sample timestamps repeat, go backwards or jump", out);
+  }
+  t_last_suspect_ = prev_.t;
+  freeze_ = true;
+  return false;
 }
 
 void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
@@ -369,8 +374,8 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
   st_.input.delta_ok = ok[2];
   if (std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta) last_delta_ = s.delta;
   // Timing errors age out of the unknown channel too.
-  prune(&ch_[2].invalids, s.t - p_.spike_window);
-  if ((cond_[2].sources & kInvalid) && ch_[2].invalids.empty()) {
+  prune(&timing_errors_, s.t - p_.spike_window);
+  if ((cond_[2].sources & kInvalid) && timing_errors_.empty()) {
     set_condition(Sensor::kUnknown, kInvalid, false, FaultKind::kInvalid, s.t,
                   "sample timestamps increase again", out);
   }

@@ -18,7 +18,10 @@ void SampleAssembler::add_ins(const InsInput& s) {
   auto it = ins_.end();
   while (it != ins_.begin() && std::prev(it)->stamp > s.stamp) --it;
   ins_.insert(it, s);
-  newest_ins_ = std::max(newest_ins_, s.stamp);
+  // Far behind the newest (an INS clock that restarted): the newest of the old time base
+  // must not hold back, nor prune the rudder samples of, the new one.
+  newest_ins_ =
+      s.stamp < newest_ins_ - (wait_ + timeout_) ? s.stamp : std::max(newest_ins_, s.stamp);
 }
 
 void SampleAssembler::add_rudder(const RudderInput& s) {
@@ -54,6 +57,17 @@ double SampleAssembler::delta_at(double t) const {
   }
   const RudderInput& last = rudder_.back();
   return t - last.stamp <= timeout_ ? last.delta : kNaN;
+}
+
+void SampleAssembler::rebase(double t, double span) {
+  const auto far = [t, span](double stamp) { return std::abs(stamp - t) > span; };
+  ins_.erase(
+      std::remove_if(ins_.begin(), ins_.end(), [&](const InsInput& s) { return far(s.stamp); }),
+      ins_.end());
+  rudder_.erase(std::remove_if(rudder_.begin(), rudder_.end(),
+                               [&](const RudderInput& s) { return far(s.stamp); }),
+                rudder_.end());
+  if (far(newest_ins_)) newest_ins_ = ins_.empty() ? t : ins_.back().stamp;
 }
 
 void SampleAssembler::drain(std::vector<Sample>* out, bool flush) {
@@ -167,10 +181,9 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       acks_(opt.ack_capacity),
       ident_q_(opt.ident_capacity),
       output_(opt.output_capacity),
-      iso_(cfg.isolation, cfg.B),
+      iso_(cfg),
       assembler_(opt.rudder_wait, opt.rudder_timeout),
-      ident_(cfg.identification, cfg.B),
-      gate_(cfg.identification_delay) {
+      ident_(cfg) {
   incarnation_ = opt.incarnation;
 }
 
@@ -180,7 +193,7 @@ void FdiPipeline::restore(const FaultEvent& ev) {
   if (started_) throw std::logic_error("FdiPipeline::restore() after start()");
   const int i = index_of(ev.sensor);
   if (i < 0 || i > 2) throw std::invalid_argument("FdiPipeline::restore(): unknown sensor");
-  latches_[i].restore(ev);
+  iso_.restore(ev);
   restored_.push_back(ev);
   current_incarnation_[i] = ev.incarnation;
   {
@@ -234,6 +247,7 @@ void FdiPipeline::emit(const FaultEvent& ev_in, bool restored) {
     std::lock_guard<std::mutex> lock(latest_m_);
     latest_[index_of(ev.sensor)] = ev;
   }
+  ++events_emitted_;
   output_.push(ev);
 }
 
@@ -288,13 +302,23 @@ void FdiPipeline::accept_rudder(const RudderInput& in) {
 }
 
 void FdiPipeline::process(const Sample& s) {
-  std::vector<Detection> dets;
   const double prev_t = last_t_;
-  const bool ok = iso_.update(s, &dets);
-  for (const Detection& d : dets) {
+  events_.clear();
+  IdentificationInput handover;
+  const bool ok = iso_.process(s, &events_, &handover);
+  for (const Detection& d : iso_.detections()) {
     recheck_[index_of(d.sensor)].pending = false;  // the detector has taken the instance over
-    FaultEvent ev;
-    if (latches_[index_of(d.sensor)].on_detection(d, iso_estimate_.A, &ev)) emit(ev);
+  }
+  for (const FaultEvent& ev : events_) emit(ev);
+  const bool resynced = iso_.clock().resyncs() != resyncs_seen_;
+  if (resynced) {
+    resyncs_seen_ = iso_.clock().resyncs();
+    log(2, fmt("INS clock re-synchronised: stamps left the time base at t=%.3f s and continue "
+               "consistently from t=%.3f s: detection and identification restarted",
+               iso_.clock().resync_from(), s.t));
+  }
+  if (!ok || resynced) {
+    assembler_.rebase(iso_.clock().last(), cfg_.clock_max_jump);
   }
   if (!ok) {
     ++rejected_;
@@ -339,21 +363,23 @@ void FdiPipeline::process(const Sample& s) {
   if (opt_.lockstep) {
     std::unique_lock<std::mutex> lock(step_m_);
     ++ident_pushed_;
-    ident_q_.push(IdentItem{s, iso_.freeze_requested()});
+    ident_q_.push(handover);
     step_cv_.wait(lock, [&] { return ident_done_ >= ident_pushed_; });
   } else {
-    ident_q_.push(IdentItem{s, iso_.freeze_requested()});
+    ident_q_.push(handover);
   }
-  bool updated = false;
+  take_estimate();
+}
+
+void FdiPipeline::take_estimate() {
+  Estimate est;
   {
     std::lock_guard<std::mutex> lock(snap_m_);
-    if (snapshot_version_ != seen_version_) {
-      iso_estimate_ = snapshot_;
-      seen_version_ = snapshot_version_;
-      updated = true;
-    }
+    if (snapshot_version_ == seen_version_) return;
+    est = snapshot_;
+    seen_version_ = snapshot_version_;
   }
-  if (updated) iso_.set_estimate(iso_estimate_);
+  iso_.set_estimate(est);
 }
 
 void FdiPipeline::recheck_restored(const Sample& s) {
@@ -389,7 +415,7 @@ void FdiPipeline::recheck_restored(const Sample& s) {
     d.threshold = i < 2 ? st.thresholds(i) : st.threshold;
     d.message = "not present after the restart: " + why + fmt(" %.1f s", opt_.restore_recheck);
     FaultEvent ev;
-    if (latches_[i].on_detection(d, iso_estimate_.A, &ev)) {
+    if (iso_.apply(d, &ev)) {
       log(1, std::string("restored ") + to_string(d.sensor) + " fault (" + to_string(rc.kind) +
                  ") " + d.message + ": now #" + std::to_string(ev.sequence) + " " +
                  to_string(ev.state));
@@ -415,7 +441,7 @@ void FdiPipeline::handle_ack(const AckInput& a) {
     refuse_ack(a, "unknown sensor", what + " refused: unknown sensor");
     return;
   }
-  FaultLatch& latch = latches_[static_cast<int>(a.sensor)];
+  const FaultLatch& latch = iso_.latch(a.sensor);
   const std::uint64_t current = latch.current().sequence;
   const std::uint64_t inc = current_incarnation_[static_cast<int>(a.sensor)];
   if (incarnation_ != 0 && a.incarnation != inc) {
@@ -430,7 +456,7 @@ void FdiPipeline::handle_ack(const AckInput& a) {
   }
   // Stamp: the time of the last sample (before any sample after a restart: the event's own).
   const double t = std::isfinite(last_t_) ? last_t_ : latch.current().t;
-  const AckResult r = latch.acknowledge(a.sequence, t, a.who, &ev);
+  const AckResult r = iso_.acknowledge(a.sensor, a.sequence, t, a.who, &ev);
   if (r == AckResult::kAccepted) {
     ++acks_accepted_;
     log(1, std::string("ack of ") + to_string(a.sensor) + " #" + std::to_string(a.sequence) +
@@ -499,10 +525,11 @@ void FdiPipeline::log_ack_summary(bool force) {
 PipelineStatus FdiPipeline::make_status() {
   PipelineStatus st;
   st.stamp = last_t_;
-  st.estimate = iso_estimate_;
+  st.estimate = iso_.estimate();
   st.isolation = iso_.status();
   st.samples = samples_.load();
   st.rejected = rejected_.load();
+  st.clock_resyncs = iso_.clock().resyncs();
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
   st.dropped_output = output_.dropped() + dropped_at_stop_.load();
@@ -680,6 +707,7 @@ void FdiPipeline::isolation_loop() {
                                            BoundedQueue<AckInput>::PopResult::kValue;
            ++k) {
         handle_ack(a);
+        ++inputs_handled_;
       }
     }
     const auto now = Clock::now();
@@ -695,6 +723,7 @@ void FdiPipeline::isolation_loop() {
       batch.clear();
       assembler_.drain(&batch);
       for (const Sample& s : batch) process(s);
+      ++inputs_handled_;
     }
     if (had_ins_ && !ins_silent_ && seconds(now - last_ins) > opt_.input_timeout) {
       ins_silent_ = true;
@@ -729,24 +758,16 @@ void FdiPipeline::isolation_loop() {
 }
 
 void FdiPipeline::identification_loop() {
-  IdentItem it;
-  double last_snapshot = -1e300;
+  IdentificationInput it;
   bool last_converged = false;
   for (;;) {
     beat_ident_.store(now_ns(), std::memory_order_relaxed);
     const auto r = ident_q_.pop_for(&it, std::chrono::milliseconds(100));
-    if (r == BoundedQueue<IdentItem>::PopResult::kShutdown) break;
-    if (r == BoundedQueue<IdentItem>::PopResult::kTimeout) continue;
-    gate_.push(it.s, it.freeze);
-    Sample old;
-    bool freeze = false;
-    bool updated = false;
-    while (gate_.pop(&old, &freeze)) {
-      ident_.update(old, freeze);
-      updated = true;
-    }
-    const Estimate& e = ident_.estimate();
-    if (updated && (e.t - last_snapshot >= opt_.snapshot_period || e.converged != last_converged)) {
+    if (r == BoundedQueue<IdentificationInput>::PopResult::kShutdown) break;
+    if (r == BoundedQueue<IdentificationInput>::PopResult::kTimeout) continue;
+    // Every new estimate goes to the isolation thread, as in FdiEngine.
+    if (ident_.push(it)) {
+      const Estimate& e = ident_.estimate();
       if (e.converged != last_converged) {
         const Mat2& A = e.A;
         char buf[200];
@@ -762,7 +783,6 @@ void FdiPipeline::identification_loop() {
         snapshot_ = e;
         ++snapshot_version_;
       }
-      last_snapshot = e.t;
       last_converged = e.converged;
     }
     if (opt_.lockstep) {

@@ -187,6 +187,139 @@ TEST(FdiPipeline, PaperScenarioThroughTheThreadsRaisesBothFaults) {
   EXPECT_EQ(p.status().rejected, 0u);
 }
 
+TEST(FdiPipeline, TheDetectorSupervisesIdentificationAsInTheReplay) {
+  // GIVEN the paper's vessel and steering without faults, long enough for the detector to
+  // arm and learn
+  VesselModel v;
+  ASSERT_TRUE(find_vessel("otter", &v));
+  SimConfig sim = paper_scenario(v, 50.0, 1);
+  sim.faults.clear();  // healthy throughout
+  sim.duration = 60.0;
+  sim.sigma_v = sim.sigma_r = 0.0;
+  EngineConfig cfg;
+  cfg.B = v.B;
+  cfg.identification.eps1 = 2.0;
+  cfg.identification.settle_windows = 2;
+  cfg.identification.settle_tolerance = 0.02;
+  cfg.isolation.sigma_v = 0.005;
+  cfg.isolation.sigma_r = 0.0005;
+  cfg.isolation.settle_time = 2.0;
+  cfg.isolation.learn_time = 3.0;
+  const std::vector<SimRow> rows = simulate(sim);
+  FdiEngine engine(cfg);
+  std::vector<FaultEvent> evs;
+  for (const SimRow& r : rows) engine.process(Sample{r.t, r.v, r.r, r.delta}, &evs);
+  const IsolatorStatus& st = engine.isolation_status();
+  ASSERT_TRUE(st.armed && !st.learning && !st.settling)
+      << "the scenario must let it learn: armed " << st.armed << " learning " << st.learning
+      << " settling " << st.settling;
+  ASSERT_TRUE(engine.estimate().supervised);
+  // WHEN the same samples run through the pipeline's threads in lock-step
+  Collected c;
+  PipelineOptions opt;
+  opt.input_capacity = 1 << 16;
+  opt.input_timeout = 1e9;  // wall-clock silence must not inject samples on a busy machine
+  opt.lockstep = true;
+  FdiPipeline p = make(cfg, &c, opt);
+  p.start();
+  for (const SimRow& r : rows) {
+    p.push_rudder({r.t, r.delta, true});
+    p.push_ins({r.t, r.v, r.r, true, true});
+  }
+  p.stop();
+  // THEN its identification is supervised by its detector too (the consistency guard's
+  // release after convergence depends on it)
+  const PipelineStatus ps = p.status();
+  EXPECT_TRUE(ps.isolation.armed && !ps.isolation.learning);
+  EXPECT_TRUE(ps.estimate.supervised);
+}
+
+/// The paper test's engine, and its noise-free scenario's rows with stamps shifted by t0.
+EngineConfig paper_config(const VesselModel& v) {
+  EngineConfig cfg;
+  cfg.B = v.B;
+  cfg.identification.eps1 = 2.0;
+  cfg.identification.settle_windows = 2;
+  cfg.identification.settle_tolerance = 0.02;
+  cfg.isolation.sigma_v = 0.005;
+  cfg.isolation.sigma_r = 0.0005;
+  cfg.isolation.settle_time = 2.0;
+  cfg.isolation.learn_time = 3.0;
+  return cfg;
+}
+
+std::vector<SimRow> paper_rows(const VesselModel& v, double duration) {
+  SimConfig sim = paper_scenario(v, 50.0, 1);
+  sim.sigma_v = sim.sigma_r = 0.0;
+  sim.duration = duration;
+  return simulate(sim);
+}
+
+/// Raises (not refinements) of the pipeline fed `rows` in lock-step, with its status.
+std::vector<FaultEvent> lockstep_raises(const EngineConfig& cfg, const std::vector<SimRow>& rows,
+                                        PipelineStatus* status) {
+  Collected c;
+  PipelineOptions opt;
+  opt.input_capacity = 1 << 16;
+  opt.input_timeout = 1e9;
+  opt.lockstep = true;
+  FdiPipeline p = make(cfg, &c, opt);
+  p.start();
+  for (const SimRow& r : rows) {
+    p.push_rudder({r.t, r.delta, true});
+    p.push_ins({r.t, r.v, r.r, true, true});
+  }
+  p.stop();
+  *status = p.status();
+  std::vector<FaultEvent> raises;
+  for (const FaultEvent& e : c.events) {
+    if (e.state == FaultState::kRaised && e.message.rfind("kind refined", 0) != 0) {
+      raises.push_back(e);
+    }
+  }
+  return raises;
+}
+
+bool raised_in(const std::vector<FaultEvent>& raises, Sensor s, double from, double to) {
+  for (const FaultEvent& e : raises) {
+    if (e.sensor == s && e.t >= from && e.t <= to) return true;
+  }
+  return false;
+}
+
+TEST(FdiPipelineClock, OneInsStampFarAheadIsRejectedAloneAndBothFaultsAreRaised) {
+  // GIVEN the paper's scenario in which the stamps of one INS and one rudder sample (t =
+  // 45 s, between the faults) jumped ahead by 1e9 s
+  VesselModel v;
+  ASSERT_TRUE(find_vessel("otter", &v));
+  std::vector<SimRow> rows = paper_rows(v, 100.0);
+  for (SimRow& r : rows) {
+    if (std::abs(r.t - 45.0) < 1e-9) r.t += 1e9;
+  }
+  // WHEN it runs through the pipeline
+  PipelineStatus st;
+  const std::vector<FaultEvent> raises = lockstep_raises(paper_config(v), rows, &st);
+  // THEN both faults are raised, and at most that sample was rejected
+  EXPECT_TRUE(raised_in(raises, Sensor::kGyro, 20.0, 23.0));
+  EXPECT_TRUE(raised_in(raises, Sensor::kAccelerometer, 60.0, 63.0));
+  EXPECT_LE(st.rejected, 1u);
+}
+
+TEST(FdiPipelineClock, AnInsClockRestartAtZeroIsAdoptedAndTheNextFaultsAreRaised) {
+  // GIVEN 15 s of the scenario, then the INS and rudder clocks restart at 0 on a whole one
+  VesselModel v;
+  ASSERT_TRUE(find_vessel("otter", &v));
+  std::vector<SimRow> rows = paper_rows(v, 15.0);
+  for (const SimRow& r : paper_rows(v, 100.0)) rows.push_back(r);
+  // WHEN it runs through the pipeline
+  PipelineStatus st;
+  const std::vector<FaultEvent> raises = lockstep_raises(paper_config(v), rows, &st);
+  // THEN the new time base is adopted (and counted), and both later faults are raised
+  EXPECT_EQ(st.clock_resyncs, 1u);
+  EXPECT_TRUE(raised_in(raises, Sensor::kGyro, 20.0, 23.0));
+  EXPECT_TRUE(raised_in(raises, Sensor::kAccelerometer, 60.0, 63.0));
+}
+
 TEST(FdiPipeline, AcksMoveTheLatchAndStaleAcksAreRefusedWithAReason) {
   // GIVEN a pipeline whose INS gyro channel goes missing (stale) for a while
   VesselModel v;

@@ -187,6 +187,8 @@ struct Estimate {
   /// Wald statistic of the memory's estimate against the recent data's own (chi-square, 4
   /// degrees of freedom when both describe one vessel; before convergence only).
   double memory_mismatch = 0.0;
+  /// A detector downstream checks the data (Identifier::set_supervised).
+  bool supervised = false;
 };
 
 class Identifier {
@@ -203,7 +205,7 @@ class Identifier {
   /// Whether a detector downstream checks the data (the isolation thread is armed and has
   /// learned): only then is a lasting inconsistency that it does not flag taken for a
   /// change of the vessel (guard_recent_time); otherwise the guard holds.
-  void set_supervised(bool supervised) { supervised_ = supervised; }
+  void set_supervised(bool supervised) { supervised_ = est_.supervised = supervised; }
 
   const Estimate& estimate() const { return est_; }
   const IdentificationParams& params() const { return p_; }

@@ -140,6 +140,9 @@ class Isolator {
   /// Processes one sample; appends every change of a sensor's fault condition to out.
   /// Returns false when the sample was rejected (time did not increase).
   bool update(const Sample& s, std::vector<Detection>* out);
+  /// A sample whose stamp does not fit the time base (repeated, backward, or far ahead):
+  /// counted, and against the unknown sensor's invalid condition. Returns false.
+  bool reject_timestamp(std::vector<Detection>* out);
 
   /// True while identification must not learn from the data (fault suspected or active,
   /// inputs unusable, or within resume_time of that).
@@ -241,8 +244,9 @@ class Isolator {
   std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
   std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
   std::array<Channel, 3> ch_;                                    ///< v, r, delta
-  std::array<Condition, 3> cond_;                                ///< accelerometer, gyro, unknown
-  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};          ///< per sensor a/g/unknown
+  std::deque<double> timing_errors_;  ///< times of repeated / backward stamps (unknown sensor)
+  std::array<Condition, 3> cond_;     ///< accelerometer, gyro, unknown
+  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown
   std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
   std::array<double, 3> raised_at_{kNaN, kNaN, kNaN};  ///< time of the residual raise
   double last_delta_ = kNaN;

@@ -71,6 +71,10 @@ class SampleAssembler {
   /// Appends the samples that are ready; flush = true releases everything.
   void drain(std::vector<Sample>* out, bool flush = false);
   std::size_t pending() const { return ins_.size(); }
+  /// The engine's time base is now at t (it re-synchronised, or rejected a stamp): samples
+  /// more than span away from it are dropped, so that they neither hold the others back
+  /// nor push the new base's rudder samples out.
+  void rebase(double t, double span);
 
  private:
   double delta_at(double t) const;
@@ -89,7 +93,6 @@ struct PipelineOptions {
   double rudder_timeout = 0.5;         ///< [s, source time]
   double input_timeout = 1.0;          ///< INS silent this long (wall clock): stale [s]
   double status_period = 1.0;          ///< FdiStatus period (wall clock) [s]
-  double snapshot_period = 0.2;        ///< estimate snapshots (source time) [s]
   /// A fault restored at start (raised or active-acknowledged) whose sensor-level condition
   /// (stale, stuck, invalid) is no longer seen for this long is cleared [s, source time];
   /// a residual fault once the re-armed detector has learned and sees none.
@@ -157,7 +160,8 @@ struct PipelineStatus {
   std::uint64_t dropped_inputs = 0;  ///< input queue overflow
   std::uint64_t dropped_ident = 0;   ///< identification queue overflow
   std::uint64_t dropped_output = 0;  ///< output queue overflow, and events left at stop()
-  std::uint64_t rejected = 0;        ///< samples the engine refused (time not increasing)
+  std::uint64_t rejected = 0;        ///< samples the engine refused for their stamp
+  std::uint64_t clock_resyncs = 0;   ///< new time bases adopted (the engine restarted on each)
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
   // Input problems, counted since start (see InputFlag for the per-period flags).
@@ -244,16 +248,18 @@ class FdiPipeline {
     std::atomic<std::uint64_t> highest_{0}, lost_{0}, restarts_{0};
   };
 
+  /// Inputs (INS, rudder, acks) the isolation thread has handled, and the events it has
+  /// handed to the publisher since start. A caller that pushes one sample, waits for the
+  /// first and for its sink to have received the second, sees each sample's events before
+  /// the next sample is processed (an operator's ack then lands where replay puts it).
+  std::uint64_t inputs_handled() const { return inputs_handled_.load(); }
+  std::uint64_t events_emitted() const { return events_emitted_.load(); }
   /// For a health check: how recently each thread went round its loop.
   PipelineLiveness liveness() const;
 
  private:
   using Input = std::variant<InsInput, RudderInput>;
   using Output = std::variant<FaultEvent, PipelineStatus>;
-  struct IdentItem {
-    Sample s;
-    bool freeze = false;
-  };
   /// A restored active fault awaiting its re-check.
   struct Recheck {
     bool pending = false;
@@ -291,6 +297,8 @@ class FdiPipeline {
   void accept_ins(const InsInput& in);
   void accept_rudder(const RudderInput& in);
   void process(const Sample& s);
+  /// Installs the identification thread's latest estimate, if there is a new one.
+  void take_estimate();
   void recheck_restored(const Sample& s);
   /// Hands an event of this run (stamped with its incarnation) to the output queue;
   /// restored = true: a restored event, re-published with the incarnation that issued it.
@@ -313,13 +321,13 @@ class FdiPipeline {
   BoundedQueue<Input> input_;
   BoundedQueue<AckInput> acks_;
   SeqGaps ins_seq_, rudder_seq_;
-  BoundedQueue<IdentItem> ident_q_;
+  BoundedQueue<IdentificationInput> ident_q_;
   BoundedQueue<Output> output_;
 
   // Isolation thread state.
-  Isolator iso_;
-  std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
-                                     FaultLatch(Sensor::kUnknown)};
+  IsolationStage iso_;
+  std::vector<FaultEvent> events_;  ///< of the sample being processed
+  std::uint64_t resyncs_seen_ = 0;  ///< clock re-synchronisations logged
   SampleAssembler assembler_;
   std::vector<FaultEvent> restored_;
   std::uint64_t incarnation_ = 0;
@@ -329,7 +337,6 @@ class FdiPipeline {
   double last_t_ = kNaN;
   double newest_ins_stamp_ = -1e300;
   std::uint64_t seen_version_ = 0;
-  Estimate iso_estimate_;
   InputProblems problems_;
   ProblemCounts logged_;        ///< counts at the previous status (per-period flags, log)
   bool rudder_paused_ = false;  ///< logged state of the rudder pause
@@ -352,8 +359,7 @@ class FdiPipeline {
   std::atomic<std::uint64_t> acks_accepted_{0}, acks_refused_{0};
 
   // Identification thread state.
-  Identifier ident_;
-  IdentificationGate gate_;
+  IdentificationStage ident_;
 
   // Shared, under snap_m_.
   mutable std::mutex snap_m_;
@@ -369,6 +375,7 @@ class FdiPipeline {
   std::array<std::uint64_t, 3> published_seq_{0, 0, 0};
 
   std::atomic<std::uint64_t> samples_{0}, rejected_{0};
+  std::atomic<std::uint64_t> inputs_handled_{0}, events_emitted_{0};
   // Lockstep bookkeeping, under step_m_.
   std::mutex step_m_;
   std::condition_variable step_cv_;

@@ -1,0 +1,160 @@
+// The source clock: one bad INS timestamp, or an INS clock that restarts, must not blind
+// detection (issue 15, item 2). Shipped configuration of the golden fault voyage.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "scenario_util.hpp"
+#include "usv_fdi/io/config.hpp"
+
+namespace usvfdi::scenario {
+namespace {
+
+const std::string kSource = USV_FDI_SOURCE_DIR;
+
+/// A 10 Hz Otter voyage; with_faults: an accelerometer bias on [150, 160) s and a gyro
+/// drift on [165, 175) s (as the golden case faults_otter).
+std::vector<SimRow> voyage(double duration, std::uint64_t seed, bool with_faults) {
+  SimConfig sim;
+  EXPECT_TRUE(find_vessel("otter", &sim.vessel));
+  sim.rate_hz = 10.0;
+  sim.duration = duration;
+  sim.seed = seed;
+  if (with_faults) {
+    sim.faults.push_back({Sensor::kAccelerometer, FaultKind::kBias, 150.0, 160.0, 0.05});
+    sim.faults.push_back({Sensor::kGyro, FaultKind::kDrift, 165.0, 175.0, 0.000333});
+  }
+  return simulate(sim);
+}
+
+struct Outcome {
+  std::vector<FaultEvent> raises;
+  std::uint64_t rejected = 0, resyncs = 0;
+};
+
+Outcome replay(const std::vector<Sample>& samples) {
+  FdiEngine engine(io::load_engine_config(kSource + "/tests/golden/faults_otter.yaml"));
+  Outcome out;
+  std::vector<FaultEvent> events;
+  for (const Sample& s : samples) {
+    events.clear();
+    engine.process(s, &events);
+    for (const FaultEvent& e : events) {
+      if (is_raise(e)) out.raises.push_back(e);
+      FaultEvent ack;
+      if (e.state == FaultState::kRaised || e.state == FaultState::kClearedUnacknowledged) {
+        engine.acknowledge(e.sensor, e.sequence, s.t, "test", &ack);
+      }
+    }
+  }
+  out.rejected = engine.rejected_samples();
+  out.resyncs = engine.clock_resyncs();
+  return out;
+}
+
+bool raised(const Outcome& o, Sensor sensor, double from, double to) {
+  for (const FaultEvent& e : o.raises) {
+    if (e.sensor == sensor && e.t >= from && e.t <= to) return true;
+  }
+  return false;
+}
+
+TEST(SourceClock, OneStampFarAheadIsRejectedAloneAndLaterFaultsAreRaised) {
+  // GIVEN the fault voyage in which the stamp of one sample at t = 100 s jumped by 1e9 s
+  std::vector<Sample> samples;
+  for (const SimRow& r : voyage(200.0, 2, true)) {
+    samples.push_back({r.t, r.v, r.r, r.delta});
+    if (std::abs(r.t - 100.0) < 1e-6) samples.back().t += 1e9;
+  }
+  // WHEN it is replayed
+  const Outcome o = replay(samples);
+  // THEN that sample alone is rejected, the time base stays, and both faults are raised
+  EXPECT_EQ(o.rejected, 1u);
+  EXPECT_EQ(o.resyncs, 0u);
+  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0));
+  EXPECT_TRUE(raised(o, Sensor::kGyro, 165.0, 177.0));
+}
+
+TEST(SourceClock, AnInsClockRestartingAtZeroIsAdoptedAndTheNextVoyagesFaultsAreRaised) {
+  // GIVEN 120 s of healthy voyage, then the INS clock restarts at 0 on a voyage with faults
+  std::vector<Sample> samples;
+  for (const SimRow& r : voyage(120.0, 3, false)) samples.push_back({r.t, r.v, r.r, r.delta});
+  for (const SimRow& r : voyage(200.0, 2, true)) samples.push_back({r.t, r.v, r.r, r.delta});
+  // WHEN it is replayed
+  const Outcome o = replay(samples);
+  // THEN the new time base is adopted after a short confirmation, and both faults of the
+  // second voyage are raised (no fault anywhere else)
+  EXPECT_EQ(o.resyncs, 1u);
+  EXPECT_LE(o.rejected, 10u);
+  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0));
+  EXPECT_TRUE(raised(o, Sensor::kGyro, 165.0, 177.0));
+  for (const FaultEvent& e : o.raises) {
+    EXPECT_TRUE(e.sensor != Sensor::kUnknown || e.kind == FaultKind::kInvalid)
+        << to_string(e.sensor) << " " << to_string(e.kind) << " at " << e.t;
+  }
+}
+
+TEST(SourceClock, AClockThatStandsStillIsRejectedSampleBySampleAndCounted) {
+  // GIVEN a stream whose stamp stops advancing for a million samples
+  FdiEngine engine(io::load_engine_config(kSource + "/tests/golden/faults_otter.yaml"));
+  std::vector<FaultEvent> events;
+  for (int k = 0; k < 100; ++k) engine.process({0.1 * k, 0.0, 0.0, 0.0}, &events);
+  for (int k = 0; k < 1000000; ++k) engine.process({9.9, 0.0, 0.0, 0.0}, &events);
+  // THEN every one is rejected and counted, and the timing fault is raised once
+  EXPECT_EQ(engine.rejected_samples(), 1000000u);
+  EXPECT_EQ(engine.isolation_status().input.rejected_time, 1000000u);
+  EXPECT_EQ(engine.clock_resyncs(), 0u);
+}
+
+}  // namespace
+}  // namespace usvfdi::scenario
+
+namespace usvfdi::scenario {
+namespace {
+
+/// Raises of a healthy 10 Hz Otter voyage (shipped config) with the samples in
+/// [from, from + length) removed.
+std::vector<FaultEvent> healthy_with_gap(double from, double length, std::uint64_t seed) {
+  std::vector<Sample> samples;
+  for (const SimRow& r : voyage(400.0, seed, false)) {
+    if (r.t >= from && r.t < from + length) continue;
+    samples.push_back({r.t, r.v, r.r, r.delta});
+  }
+  FdiEngine engine(io::load_engine_config(kSource + "/config/vessels/otter.yaml"));
+  std::vector<FaultEvent> events, raises;
+  for (const Sample& s : samples) {
+    events.clear();
+    engine.process(s, &events);
+    for (const FaultEvent& e : events) {
+      if (is_raise(e)) raises.push_back(e);
+    }
+  }
+  return raises;
+}
+
+// Issue 15, item 11, NOT FIXED YET (disabled: it fails). Found so far: every gap length
+// tried (0.3-20 s) gives false gyro bias/drift raises about 7-8 s after the gap, i.e. just
+// after the observers' settle_time (6 s) following their restart at the gap; with
+// isolation.settle_time = 20 s none are raised. Freezing identification across the gap
+// and restarting the observers and windows at every gap of more than 2.5 sample
+// intervals did not remove them. Run with --gtest_also_run_disabled_tests.
+TEST(InputGap, DISABLED_ABlockOfMissingSamplesInAHealthyVoyageRaisesNothing) {
+  // GIVEN healthy voyages with gaps of 0.3 s to 20 s after the detector has learned
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    for (double length : {0.3, 0.45, 0.8, 2.0, 5.0, 20.0}) {
+      for (double from : {200.0, 260.3, 320.7}) {
+        SCOPED_TRACE("seed " + std::to_string(seed) + ", gap of " + std::to_string(length) +
+                     " s at " + std::to_string(from) + " s");
+        // WHEN they are replayed THEN no fault is raised
+        for (const FaultEvent& e : healthy_with_gap(from, length, seed)) {
+          ADD_FAILURE() << to_string(e.sensor) << " " << to_string(e.kind) << " raised at " << e.t
+                        << ": " << e.message;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace usvfdi::scenario
