@@ -24,6 +24,7 @@
 
 #include "commands.hpp"
 #include "dds_options.hpp"
+#include "instance_owners.hpp"
 #include "usv_fdi/dds_service/convert.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/jsonl.hpp"
@@ -175,35 +176,37 @@ std::string json_change(const VesselLiveness::Change& c, double silent_after) {
   return os.str();
 }
 
-void print_table(const std::map<RowKey, Row>& rows,
-                 const std::map<std::uint32_t, VesselStatus>* vessels, const VesselLiveness& live) {
+void print_table(const InstanceOwners<RowKey, Row>& rows,
+                 const InstanceOwners<std::uint32_t, VesselStatus>* vessels,
+                 const VesselLiveness& live, int conflicts) {
   const double now = wall_now();
   std::printf("%-10s %-13s %-21s %-8s %5s %5s %4s %8s %8s %7s  %s\n", "VESSEL", "SENSOR", "STATE",
               "KIND", "C_A", "C_G", "SEQ", "ONSET[s]", "T[s]", "AGE[s]", "MESSAGE");
-  for (const auto& [key, r] : rows) {
+  bool any_gone = false;
+  std::set<std::uint32_t> gone_vessels;
+  rows.for_each([&](const RowKey&, const Row& r) {
     std::string state = to_string(r.ev.state);
-    if (!r.alive) state += "?";  // the sidecar is gone: last known state
+    if (!r.alive) {
+      state += "?";  // the sidecar is gone: last known state
+      any_gone = true;
+      gone_vessels.insert(r.mmsi);
+    }
     std::printf("%-10u %-13s %-21s %-8s %5.2f %5.2f %4llu %8.2f %8.2f %7.1f  %s\n", r.mmsi,
                 to_string(r.ev.sensor), state.c_str(), to_string(r.ev.kind), r.ev.c_a, r.ev.c_g,
                 static_cast<unsigned long long>(r.ev.sequence), r.ev.onset_time, r.ev.t,
                 now - r.written, r.ev.message.c_str());
-  }
+  });
   std::printf("(%zu fault instances%s)\n", rows.size(),
-              std::any_of(rows.begin(), rows.end(), [](const auto& kv) { return !kv.second.alive; })
-                  ? "; '?': sidecar gone, last known state"
-                  : "");
+              any_gone ? "; '?': sidecar gone, last known state" : "");
+  if (conflicts > 0) {
+    std::printf("!! %d conflicting writer(s) refused or held: see the log (CONFLICT ...)\n",
+                conflicts);
+  }
   // One line per vessel heard: how long ago; with --status also its FdiStatus.
   for (const std::uint32_t mmsi : live.vessels()) {
-    const VesselStatus* vs = nullptr;
-    if (vessels != nullptr) {
-      const auto it = vessels->find(mmsi);
-      if (it != vessels->end()) vs = &it->second;
-    }
+    const VesselStatus* vs = vessels != nullptr ? vessels->shown(mmsi) : nullptr;
     if (vs == nullptr) {
-      const bool gone = std::any_of(rows.begin(), rows.end(), [&](const auto& kv) {
-        return kv.second.mmsi == mmsi && !kv.second.alive;
-      });
-      std::printf("%s\n", heard_line(mmsi, live, gone).c_str());
+      std::printf("%s\n", heard_line(mmsi, live, gone_vessels.count(mmsi) > 0).c_str());
       continue;
     }
     const fdi::FdiStatus& s = vs->st;
@@ -277,12 +280,32 @@ class GoneWriters : public fdds::DataReaderListener {
   std::vector<fdds::InstanceHandle_t> gone_, back_;
 };
 
+/// The text naming a writer in a conflict report: its GUID, its identity's CN and its partitions.
+std::string writer_name(const dds::DdsContext& ctx, const fdds::InstanceHandle_t& h) {
+  std::ostringstream os;
+  os << eprosima::fastrtps::rtps::iHandle2GUID(h);
+  const auto w = ctx.peers().writer(h);
+  if (w) {
+    const std::string cn = dds::common_name(w->subject);
+    if (!cn.empty()) os << " (identity " << cn << ")";
+    std::string parts;
+    for (const auto& p : w->partitions) parts += (parts.empty() ? "" : ",") + p;
+    os << " [partition " << (parts.empty() ? std::string("<default>") : parts) << "]";
+  }
+  return os.str();
+}
+
 /// The FaultEvent and FdiStatus side of the monitor. The FdiStatus reader exists even without
-/// --status: the periodic status is what tells a quiet vessel from a silent one.
+/// --status: the periodic status is what tells a quiet vessel from a silent one. Every sample
+/// passes InstanceOwners: only the writer that owns an instance updates it.
 class FleetView {
  public:
   FleetView(dds::DdsContext& ctx, const MonitorArgs& a)
-      : ctx_(ctx), a_(a), filter_(a.mmsi.begin(), a.mmsi.end()), live_(a.silent_after) {
+      : ctx_(ctx),
+        a_(a),
+        secure_(ctx.secure()),
+        filter_(a.mmsi.begin(), a.mmsi.end()),
+        live_(a.silent_after) {
     events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader,
                                  &events_gone_, fdds::StatusMask::subscription_matched());
     events_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
@@ -316,13 +339,12 @@ class FleetView {
       if (!info.valid_data) {
         // Disposed / no writers: keep the last known state, flagged.
         const auto it = handles_.find(info.instance_handle);
-        if (it != handles_.end() && rows_.count(it->second)) {
-          Row& r = rows_[it->second];
-          if (r.alive) {
-            r.alive = false;
-            changed = true;
-            if (a_.json) emit_json(r);
-          }
+        Row* r = it == handles_.end() ? nullptr : rows_.shown(it->second);
+        if (r != nullptr && r->alive &&
+            writer_id(info.publication_handle) == writer_id(r->writer)) {
+          r->alive = false;
+          changed = true;
+          if (a_.json) emit_json(*r);
         }
         continue;
       }
@@ -339,31 +361,41 @@ class FleetView {
       r.writer = info.publication_handle;
       const RowKey key{r.mmsi, static_cast<int>(r.ev.sensor)};
       handles_[info.instance_handle] = key;
-      rows_[key] = r;
+      const OwnerDecision dec =
+          rows_.offer(key, r.mmsi, writer_ref(info.publication_handle), r.ev.sequence, r);
+      if (dec.report)
+        report(dec, r.mmsi, to_string(r.ev.sensor), info.publication_handle, r.ev.sequence,
+               to_string(r.ev.state));
+      if (dec.verdict != OwnerDecision::Verdict::kShown) continue;
       changed = true;
       if (a_.json) emit_json(r);
     }
     {
-      fdi::FdiStatus s;
-      while (status_->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
+      fdi::FdiStatus st;
+      while (status_->take_next_sample(&st, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) {
           const auto it = status_handles_.find(info.instance_handle);
-          if (it != status_handles_.end() && vessels_.count(it->second)) {
-            vessels_[it->second].alive = false;
+          VesselStatus* v = it == status_handles_.end() ? nullptr : vessels_.shown(it->second);
+          if (v != nullptr && writer_id(info.publication_handle) == writer_id(v->writer)) {
+            v->alive = false;
             changed = a_.status || changed;
           }
           continue;
         }
-        if (!filter_.empty() && !filter_.count(s.mmsi())) continue;
-        changed |= heard(s.mmsi());
-        VesselStatus& v = vessels_[s.mmsi()];
-        v.st = s;
+        if (!filter_.empty() && !filter_.count(st.mmsi())) continue;
+        changed |= heard(st.mmsi());
+        VesselStatus v;
+        v.st = st;
         v.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
         v.writer = info.publication_handle;
         v.alive = true;
-        status_handles_[info.instance_handle] = s.mmsi();
+        status_handles_[info.instance_handle] = st.mmsi();
+        const OwnerDecision dec =
+            vessels_.offer(st.mmsi(), st.mmsi(), writer_ref(info.publication_handle), 0, v);
+        if (dec.report) report(dec, st.mmsi(), "status", info.publication_handle, 0, "");
+        if (dec.verdict != OwnerDecision::Verdict::kShown) continue;
         if (a_.json && a_.status) {
-          std::printf("%s\n", json_status(v, live_.age(s.mmsi(), mono_now())).c_str());
+          std::printf("%s\n", json_status(v, live_.age(st.mmsi(), mono_now())).c_str());
           std::fflush(stdout);
         }
       }
@@ -380,36 +412,106 @@ class FleetView {
     events_->get_subscription_matched_status(st);
     return st.current_count;
   }
-  const std::map<RowKey, Row>& rows() const { return rows_; }
-  const std::map<std::uint32_t, VesselStatus>* vessels() const {
+  /// The fault instance shown for `key` (nullptr: none).
+  const Row* row(const RowKey& key) const { return rows_.shown(key); }
+  const InstanceOwners<RowKey, Row>& rows() const { return rows_; }
+  const InstanceOwners<std::uint32_t, VesselStatus>* vessels() const {
     return a_.status ? &vessels_ : nullptr;
   }
   const VesselLiveness& liveness() const { return live_; }
   /// Seconds since anything was received from `mmsi` (NaN: never).
   double heard_age(std::uint32_t mmsi) const { return live_.age(mmsi, mono_now()); }
+  /// Conflicts reported so far (writers refused or held).
+  int conflicts() const { return conflicts_; }
 
  private:
-  /// Flags the rows (and vessel statuses) whose writer is gone. Returns true if one changed.
+  static std::string writer_id(const fdds::InstanceHandle_t& h) {
+    std::ostringstream os;
+    os << eprosima::fastrtps::rtps::iHandle2GUID(h);
+    return os.str();
+  }
+  /// The writer as InstanceOwners sees it. Under DDS Security a writer whose only partition is a
+  /// vessel's is authenticated for that vessel: access control matched it against the signed
+  /// permissions of its identity.
+  WriterRef writer_ref(const fdds::InstanceHandle_t& h) const {
+    WriterRef w;
+    w.id = writer_id(h);
+    if (secure_) {
+      const auto info = ctx_.peers().writer(h);
+      if (info) w.vessel = dds::vessel_of_writer(info->partitions);
+    }
+    return w;
+  }
+
+  /// Says loudly that a writer other than an instance's owner wrote it (or that the owner
+  /// changed): on stderr, and as a "conflict" object with --json.
+  void report(const OwnerDecision& d, std::uint32_t mmsi, const char* sensor,
+              const fdds::InstanceHandle_t& writer, std::uint64_t seq, const std::string& state) {
+    const bool conflict = d.verdict != OwnerDecision::Verdict::kShown;
+    if (conflict) ++conflicts_;
+    const std::string w = writer_name(ctx_, writer);
+    const std::string what = seq > 0 ? " #" + std::to_string(seq) + " " + state : std::string();
+    const std::string owner = d.owner.id.empty() ? std::string("nobody") : d.owner.id;
+    const std::string owner_seq =
+        d.owner.id.empty() || seq == 0 ? std::string() : " #" + std::to_string(d.owner_sequence);
+    if (conflict) {
+      spdlog::warn(
+          "CONFLICT vessel {} {}: writer {} wrote{} but the instance belongs to writer {}{}: {} "
+          "({}); the owner's state is kept",
+          mmsi, sensor, w, what, owner, owner_seq,
+          d.verdict == OwnerDecision::Verdict::kHeld ? "held, not shown" : "refused",
+          to_string(d.why));
+    } else {
+      spdlog::warn("vessel {} {}: writer {} now owns the instance ({}; it was writer {}{})", mmsi,
+                   sensor, w, to_string(d.why), owner, owner_seq);
+    }
+    if (!a_.json) return;
+    std::ostringstream os;
+    os << "{\"type\":\"conflict\",\"mmsi\":" << mmsi << ",\"sensor\":\"" << sensor
+       << "\",\"verdict\":\""
+       << (d.verdict == OwnerDecision::Verdict::kShown  ? "shown"
+           : d.verdict == OwnerDecision::Verdict::kHeld ? "held"
+                                                        : "refused")
+       << "\",\"why\":" << io::json_string(to_string(d.why)) << ",\"writer\":" << io::json_string(w)
+       << ",\"sequence\":" << seq << ",\"state\":" << io::json_string(state)
+       << ",\"owner\":" << io::json_string(owner) << ",\"owner_sequence\":" << d.owner_sequence
+       << "}";
+    std::printf("%s\n", os.str().c_str());
+    std::fflush(stdout);
+  }
+
+  /// Flags the rows (and vessel statuses) whose writer is gone, or shows the held writer that
+  /// takes over. Returns true if one changed.
   bool mark_gone_writers() {
     bool changed = false;
     std::vector<fdds::InstanceHandle_t> gone, back;
     events_gone_.take(&gone, &back);
+    for (const auto& h : back) rows_.writer_back(writer_id(h));
     for (const auto& h : gone) {
-      for (auto& [key, r] : rows_) {
-        if (r.writer == h && r.alive) {
-          r.alive = false;
-          changed = true;
-          if (a_.json) emit_json(r);
+      for (const auto& [key, next] : rows_.writer_gone(writer_id(h))) {
+        Row* r = rows_.shown(key);
+        if (r == nullptr) continue;
+        if (next) {
+          spdlog::warn("vessel {} {}: its writer left; now showing writer {}", key.first,
+                       to_string(r->ev.sensor), next->id);
+          r->alive = true;
+        } else if (r->alive) {
+          r->alive = false;
+        } else {
+          continue;
         }
+        changed = true;
+        if (a_.json) emit_json(*r);
       }
     }
     status_gone_.take(&gone, &back);
+    for (const auto& h : back) vessels_.writer_back(writer_id(h));
     for (const auto& h : gone) {
-      for (auto& [m, v] : vessels_) {
-        if (v.writer == h && v.alive) {
-          v.alive = false;
-          changed = a_.status || changed;
-        }
+      for (const auto& [m, next] : vessels_.writer_gone(writer_id(h))) {
+        VesselStatus* v = vessels_.shown(m);
+        if (v == nullptr) continue;
+        v->alive = next.has_value();
+        changed = a_.status || changed;
       }
     }
     return changed;
@@ -440,16 +542,18 @@ class FleetView {
 
   dds::DdsContext& ctx_;
   const MonitorArgs& a_;
+  bool secure_;
   std::set<std::uint32_t> filter_;
   GoneWriters events_gone_, status_gone_;
   fdds::DataReader* events_ = nullptr;
   fdds::DataReader* status_ = nullptr;
   fdds::WaitSet ws_;
-  std::map<RowKey, Row> rows_;
+  InstanceOwners<RowKey, Row> rows_;
   std::map<fdds::InstanceHandle_t, RowKey> handles_;
-  std::map<std::uint32_t, VesselStatus> vessels_;
+  InstanceOwners<std::uint32_t, VesselStatus> vessels_;
   std::map<fdds::InstanceHandle_t, std::uint32_t> status_handles_;
   VesselLiveness live_;
+  int conflicts_ = 0;
 };
 
 /// Why the sidecar will refuse an ack, judged from the latched state the monitor sees.
@@ -465,73 +569,119 @@ std::string refusal_reason(const fdi::FaultAck& ack, const Row* row) {
   return "no confirmation from the sidecar" + state;
 }
 
-int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
-              std::vector<fdi::FaultAck> acks) {
-  fdds::DataWriter& w = ctx.create_writer(dds::TopicId::kFaultAck, dds::profiles::kFaultAckWriter);
-  // Bounded wait until a sidecar's ack reader is matched (so the ack is not lost) and the
-  // latched state has arrived (so that the confirmation can be recognised).
-  const auto t_start = Clock::now();
-  const auto deadline = t_start + std::chrono::duration_cast<Clock::duration>(
-                                      std::chrono::duration<double>(a.discovery_timeout));
-  fdds::PublicationMatchedStatus st;
-  for (;;) {
-    w.get_publication_matched_status(st);
-    if (st.current_count > 0 || Clock::now() >= deadline) break;
+/// The partitions an acknowledgement to vessel `mmsi` is written in: the monitor's own, with a
+/// vessel wildcard ("vessel-*", after any prefix) narrowed to that vessel's partition. Under DDS
+/// Security a shore identity may write acks only into the partitions of the vessels it is granted.
+std::vector<std::string> ack_partitions(const std::vector<std::string>& mine, std::uint32_t mmsi) {
+  std::vector<std::string> out;
+  for (const std::string& p : mine) {
+    const std::string tag = "vessel-*";
+    const bool wildcard =
+        p.size() >= tag.size() && p.compare(p.size() - tag.size(), tag.size(), tag) == 0;
+    out.push_back(wildcard ? p.substr(0, p.size() - 1) + std::to_string(mmsi) : p);
+  }
+  return out;
+}
+
+/// Sends one ack and waits for the sidecar's confirmation. Returns true if it was accepted.
+bool send_ack(fdds::DataWriter& w, FleetView& view, const MonitorArgs& a, fdi::FaultAck ack,
+              bool* stop) {
+  const RowKey key{ack.mmsi(), ack.sensor()};
+  const Row* row = view.row(key);
+  const std::string who = "MMSI " + std::to_string(ack.mmsi()) + " " +
+                          to_string(static_cast<Sensor>(ack.sensor())) + " #" +
+                          std::to_string(ack.sequence());
+  ack.stamp(wall_now());
+  dds::write(w, ack);
+  spdlog::info("ack sent: {} by {}", who, a.operator_id);
+  // Confirmed when the instance moves from the acknowledged sequence past it, to an
+  // acknowledged state. If the latched state is already past it, the ack is stale: the
+  // sidecar refuses it, no need to wait.
+  const bool already_past = row != nullptr && row->ev.sequence > ack.sequence();
+  const auto confirm_by =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(already_past ? 0.0 : a.ack_timeout));
+  bool confirmed = false;
+  while (!confirmed && Clock::now() < confirm_by) {
     view.poll(0.05);
-    if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
-  }
-  if (st.current_count == 0) {
-    spdlog::error("no sidecar subscribes to acknowledgements on domain {} (waited {:g} s)",
-                  ctx.config().domain_id, a.discovery_timeout);
-    return kExitFailure;
-  }
-  spdlog::debug("{} sidecar(s) matched after {:.3f} s", st.current_count,
-                std::chrono::duration<double>(Clock::now() - t_start).count());
-  // The reader side of the match completes asynchronously; give it, and the historical
-  // FaultEvents, a moment (bounded).
-  const auto settle = Clock::now() + std::chrono::milliseconds(300);
-  while (Clock::now() < settle) view.poll(0.05);
-  int rc = kExitOk;
-  for (fdi::FaultAck& ack : acks) {
-    const RowKey key{ack.mmsi(), ack.sensor()};
-    const auto it = view.rows().find(key);
-    const Row* row = it == view.rows().end() ? nullptr : &it->second;
-    const std::string who = "MMSI " + std::to_string(ack.mmsi()) + " " +
-                            to_string(static_cast<Sensor>(ack.sensor())) + " #" +
-                            std::to_string(ack.sequence());
-    ack.stamp(wall_now());
-    dds::write(w, ack);
-    spdlog::info("ack sent: {} by {}", who, a.operator_id);
-    // Confirmed when the instance moves from the acknowledged sequence past it, to an
-    // acknowledged state. If the latched state is already past it, the ack is stale: the
-    // sidecar refuses it, no need to wait.
-    const bool already_past = row != nullptr && row->ev.sequence > ack.sequence();
-    const auto confirm_by =
-        Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>(already_past ? 0.0 : a.ack_timeout));
-    bool confirmed = false;
-    while (!confirmed && Clock::now() < confirm_by) {
-      view.poll(0.05);
-      const auto r = view.rows().find(key);
-      confirmed = r != view.rows().end() && r->second.ev.sequence > ack.sequence() &&
-                  (r->second.ev.state == FaultState::kActiveAcknowledged ||
-                   r->second.ev.state == FaultState::kAcknowledged);
-      if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
+    const Row* r = view.row(key);
+    confirmed = r != nullptr && r->ev.sequence > ack.sequence() &&
+                (r->ev.state == FaultState::kActiveAcknowledged ||
+                 r->ev.state == FaultState::kAcknowledged);
+    if (wait_for_stop_signal(0.0) != 0) {
+      *stop = true;
+      return false;
     }
-    if (!confirmed) {
-      const auto r = view.rows().find(key);
-      const std::string reason = refusal_reason(ack, r == view.rows().end() ? row : &r->second);
-      if (already_past) {
-        spdlog::error("ack {} not accepted: {} (the sidecar logs its refusal)", who, reason);
-      } else {
-        spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
-                      a.ack_timeout, reason);
+  }
+  if (!confirmed) {
+    const Row* r = view.row(key);
+    const std::string reason = refusal_reason(ack, r != nullptr ? r : row);
+    if (already_past) {
+      spdlog::error("ack {} not accepted: {} (the sidecar logs its refusal)", who, reason);
+    } else {
+      spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
+                    a.ack_timeout, reason);
+    }
+    return false;
+  }
+  const Row& now = *view.row(key);
+  spdlog::info("ack {} accepted: now #{} {}", who, now.ev.sequence, to_string(now.ev.state));
+  return true;
+}
+
+int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
+              const std::vector<fdi::FaultAck>& acks) {
+  int rc = kExitOk;
+  std::map<std::uint32_t, fdds::DataWriter*> writers;  // one per vessel, in its partition
+  for (const fdi::FaultAck& ack : acks) {
+    fdds::DataWriter*& w = writers[ack.mmsi()];
+    if (w == nullptr) {
+      const auto parts = ack_partitions(ctx.config().publisher_partitions, ack.mmsi());
+      try {
+        w = &ctx.create_writer_in_partitions(dds::TopicId::kFaultAck,
+                                             dds::profiles::kFaultAckWriter, parts);
+      } catch (const std::exception& e) {
+        spdlog::error(
+            "cannot acknowledge vessel {}: {}{}", ack.mmsi(), e.what(),
+            ctx.secure() ? " (under DDS Security: is this identity granted the vessel?)" : "");
+        rc = kExitFailure;
+        continue;
       }
-      rc = kExitFailure;
+      // Bounded wait until a sidecar's ack reader is matched (so the ack is not lost) and the
+      // latched state has arrived (so that the confirmation can be recognised).
+      const auto t_start = Clock::now();
+      const auto deadline = t_start + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(a.discovery_timeout));
+      fdds::PublicationMatchedStatus st;
+      for (;;) {
+        w->get_publication_matched_status(st);
+        if (st.current_count > 0 || Clock::now() >= deadline) break;
+        view.poll(0.05);
+        if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
+      }
+      if (st.current_count == 0) {
+        spdlog::error(
+            "no sidecar subscribes to acknowledgements of vessel {} on domain {} (waited {:g} s)",
+            ack.mmsi(), ctx.config().domain_id, a.discovery_timeout);
+        rc = kExitFailure;
+        continue;
+      }
+      spdlog::debug("{} sidecar(s) matched after {:.3f} s", st.current_count,
+                    std::chrono::duration<double>(Clock::now() - t_start).count());
+      // The reader side of the match completes asynchronously; give it, and the historical
+      // FaultEvents, a moment (bounded).
+      const auto settle = Clock::now() + std::chrono::milliseconds(300);
+      while (Clock::now() < settle) view.poll(0.05);
+    }
+    fdds::PublicationMatchedStatus st;
+    w->get_publication_matched_status(st);
+    if (st.current_count == 0) {
+      rc = kExitFailure;  // reported above
       continue;
     }
-    const Row& now = view.rows().at(key);
-    spdlog::info("ack {} accepted: now #{} {}", who, now.ev.sequence, to_string(now.ev.state));
+    bool stop = false;
+    if (!send_ack(*w, view, a, ack, &stop)) rc = kExitFailure;
+    if (stop) return kExitFailure;
   }
   return rc;
 }
@@ -577,7 +727,7 @@ int run_monitor(const MonitorArgs& a) {
   for (;;) {
     const bool changed = view->poll(0.2);
     if (changed && !a.json && !a.once) {
-      print_table(view->rows(), view->vessels(), view->liveness());
+      print_table(view->rows(), view->vessels(), view->liveness(), view->conflicts());
       printed = true;
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
@@ -586,20 +736,20 @@ int run_monitor(const MonitorArgs& a) {
   }
   if (a.once) {
     if (a.json) {
-      for (const auto& [key, r] : view->rows()) {
+      view->rows().for_each([&](const RowKey&, const Row& r) {
         std::printf("%s\n", json_row(r, view->heard_age(r.mmsi)).c_str());
-      }
+      });
       if (view->vessels() != nullptr) {
-        for (const auto& [m, v] : *view->vessels()) {
+        view->vessels()->for_each([&](const std::uint32_t& m, const VesselStatus& v) {
           std::printf("%s\n", json_status(v, view->heard_age(m)).c_str());
-        }
+        });
       }
       std::fflush(stdout);
     } else {
-      print_table(view->rows(), view->vessels(), view->liveness());
+      print_table(view->rows(), view->vessels(), view->liveness(), view->conflicts());
     }
   } else if (!a.json && !printed) {
-    print_table(view->rows(), view->vessels(), view->liveness());
+    print_table(view->rows(), view->vessels(), view->liveness(), view->conflicts());
   }
   if (a.expect > 0 && static_cast<int>(view->rows().size()) < a.expect) {
     spdlog::error("saw {} fault instances, expected {}", view->rows().size(), a.expect);

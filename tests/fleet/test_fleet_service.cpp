@@ -355,11 +355,13 @@ TEST(FleetService, SecureFleetWithUnicastDiscovery) {
     }
   } remove_pki{o.secure_pki};
   std::vector<std::string> argv = {kSource + "/scripts/make-security.sh", o.secure_pki, "--force",
-                                   "--identity", "shore:shore"};
+                                   "--identity", "shore:shore:*"};
   std::string peers = "10.77.0.5";
   for (unsigned i = 1; i <= o.vessels; ++i) {
     const std::string v = "vessel" + std::to_string(i);
-    argv.insert(argv.end(), {"--identity", "vessel:" + v, "--identity", "sensors:" + v + "-sim"});
+    const std::string m = std::to_string(257000000 + i);  // each identity bound to its vessel
+    argv.insert(argv.end(), {"--identity", "vessel:" + v + ":" + m, "--identity",
+                             "sensors:" + v + "-sim:" + m});
     peers += ",10.77.0." + std::to_string(10 + i);
   }
   argv.insert(argv.end(), {"--initial-peers", peers});

@@ -38,11 +38,12 @@ fail() {
 
 fleet_netns_up "$name" 2 || fail "namespaces not made"
 peers="$(fleet_netns_addr "$name" shore),$(fleet_netns_addr "$name" v1),$(fleet_netns_addr "$name" v2)"
-"$make_security" "$work/fleet" --identity vessel:vessel --identity shore:shore \
+"$make_security" "$work/fleet" --identity vessel:vessel:257000001 --identity shore:shore:257000001 \
   --initial-peers "$peers" >"$work/pki.log" 2>&1 || fail "make-security.sh (fleet)"
-"$make_security" "$work/foreign" --ca-name "foreign CA" --identity shore:shore \
+"$make_security" "$work/foreign" --ca-name "foreign CA" --identity 'shore:shore:*' \
   --initial-peers "$peers" >>"$work/pki.log" 2>&1 || fail "make-security.sh (foreign)"
-dds=(--qos "$qos" --domain 7 --partition fleet)
+# The vessel's partition: its identity may publish nowhere else.
+dds=(--qos "$qos" --domain 7 --partition vessel-257000001)
 
 fleet_netns_exec "$name" v1 "$probe" sidecar "${dds[@]}" --security "$work/fleet/security_profiles.xml" \
   --participant-profile usv_fdi_secure_vessel_unicast --mmsi 257000001 --sensors 2 --timeout 60 \

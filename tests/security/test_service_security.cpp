@@ -45,9 +45,17 @@ using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
 
 constexpr const char* kExe = USV_FDI_EXE;
+constexpr const char* kProbe = USV_FDI_DDS_PROBE;
 const std::string kSource = USV_FDI_SOURCE_DIR;
 constexpr unsigned kMmsi = 257000001;
 const std::string kM = std::to_string(kMmsi);
+constexpr unsigned kOther = 257000002;  ///< another vessel of the fleet
+const std::string kO = std::to_string(kOther);
+
+/// The prefix of this test process's vessel partitions (the PKI's --partition-prefix).
+std::string partition_prefix() {
+  return "usv_fdi_service_security_" + std::to_string(::getpid()) + "_";
+}
 
 fs::path g_pki;  // set by the environment below
 
@@ -68,11 +76,16 @@ class PkiEnvironment : public ::testing::Environment {
     g_pki = fs::path(USV_FDI_SECURITY_WORKDIR) / ("service-pki-" + std::to_string(::getpid()));
     fs::remove_all(g_pki);
     fs::create_directories(g_pki);
+    // One identity per vessel, bound to its partition <prefix>vessel-<MMSI>; "shore" may
+    // acknowledge vessel kMmsi, "shore2" only vessel kOther.
+    const std::string prefix = partition_prefix();
     for (const auto& args : std::vector<std::vector<std::string>>{
-             {(g_pki / "fleet").string(), "--identity", "vessel:vessel", "--identity",
-              "sensors:sensors", "--identity", "shore:shore", "--identity", "observer:observer"},
-             {(g_pki / "foreign").string(), "--ca-name", "foreign CA", "--identity", "shore:shore",
-              "--identity", "sensors:sensors"}}) {
+             {(g_pki / "fleet").string(), "--partition-prefix", prefix, "--identity",
+              "vessel:vessel:" + kM, "--identity", "sensors:sensors:" + kM, "--identity",
+              "vessel:vessel2:" + kO, "--identity", "shore:shore:" + kM, "--identity",
+              "shore:shore2:" + kO, "--identity", "observer:observer"},
+             {(g_pki / "foreign").string(), "--partition-prefix", prefix, "--ca-name", "foreign CA",
+              "--identity", "shore:shore:*", "--identity", "sensors:sensors:" + kM}}) {
       std::vector<std::string> argv = {USV_FDI_MAKE_SECURITY};
       argv.insert(argv.end(), args.begin(), args.end());
       ChildProcess p(argv);
@@ -113,7 +126,7 @@ class ServiceSecurity : public ::testing::Test {
            "/";
     fs::create_directories(dir_);
     domain_ = std::to_string(1 + ::getpid() % 200);
-    partition_ = "usv_fdi_service_security_" + std::to_string(::getpid()) + "_vessel-";
+    partition_ = partition_prefix() + "vessel-";
   }
   void TearDown() override {
     procs_.clear();
@@ -129,8 +142,10 @@ class ServiceSecurity : public ::testing::Test {
   /// in the fleet (docker/compose.secure.yaml): the vessel's (sidecar, sensors)
   /// <prefix>vessel-<MMSI>, a monitor's <prefix>vessel-* (so access control sees the wildcard the
   /// shore uses).
-  ChildProcess& start(const std::string& name, const Identity& id, std::vector<std::string> args) {
-    const std::string partition = partition_ + (args.at(0) == "monitor" ? "*" : kM);
+  /// `vessel`: the vessel partition of a non-monitor process (default: kMmsi's).
+  ChildProcess& start(const std::string& name, const Identity& id, std::vector<std::string> args,
+                      const std::string& vessel = kM) {
+    const std::string partition = partition_ + (args.at(0) == "monitor" ? "*" : vessel);
     std::vector<std::string> argv = {kExe};
     argv.insert(argv.end(), args.begin(), args.end());
     argv.insert(argv.end(),
@@ -139,6 +154,27 @@ class ServiceSecurity : public ::testing::Test {
     std::vector<std::string> env;  // a plain participant: the shipped profiles only
     if (!id.profiles.empty()) env.push_back("FASTRTPS_DEFAULT_PROFILES_FILE=" + id.profiles);
     auto p = std::make_unique<ChildProcess>(argv, dir_ + name + ".log", env);
+    ChildProcess& ref = *p;
+    procs_[name] = std::move(p);
+    return ref;
+  }
+  /// Starts `usv_fdi_dds_probe MODE ARGS` as `id` in the partition of vessel `vessel`.
+  ChildProcess& start_probe(const std::string& name, const Identity& id, const std::string& mode,
+                            std::vector<std::string> args, const std::string& vessel) {
+    std::vector<std::string> argv = {kProbe,
+                                     mode,
+                                     "--profiles",
+                                     kSource + "/config/qos/usv_fdi_profiles.xml",
+                                     "--domain",
+                                     domain_,
+                                     "--partition",
+                                     partition_ + vessel,
+                                     "--participant-profile",
+                                     id.participant};
+    argv.insert(argv.end(), args.begin(), args.end());
+    auto p = std::make_unique<ChildProcess>(
+        argv, dir_ + name + ".log",
+        std::vector<std::string>{"FASTRTPS_DEFAULT_PROFILES_FILE=" + id.profiles});
     ChildProcess& ref = *p;
     procs_[name] = std::move(p);
     return ref;
@@ -154,8 +190,8 @@ class ServiceSecurity : public ::testing::Test {
   }
   /// Runs a process to its end (bounded): exit code (-1: still running), stdout in *out.
   int run(const std::string& name, const Identity& id, std::vector<std::string> args,
-          milliseconds timeout, std::string* out = nullptr) {
-    ChildProcess& p = start(name, id, std::move(args));
+          milliseconds timeout, std::string* out = nullptr, const std::string& vessel = kM) {
+    ChildProcess& p = start(name, id, std::move(args), vessel);
     const std::string text = p.read_all(timeout);
     if (out != nullptr) *out = text;
     return p.wait_exit(milliseconds(5000)).value_or(-1);
@@ -273,11 +309,11 @@ TEST_F(ServiceSecurity, AuthorisedShoreReceivesTheEventsAndAcknowledges) {
   EXPECT_GE(mon.of(kMmsi, "accelerometer").back().c_a, 0.8) << mon.dump();
   // WHEN the shore acknowledges the cleared gyro event
   int attempts = 0;
-  const int ack = shore_ack(kM + ":gyro:2", "ack of gyro #2 by shore-op accepted", &attempts);
+  const int ack = shore_ack(kM + ":gyro:2", "ack of gyro #2 by shore:shore-op accepted", &attempts);
   // THEN the sidecar accepts it and the shore sees the event acknowledged
   EXPECT_EQ(ack, 0) << log("ack1") << log("sidecar");
   std::printf("shore ack accepted after %d attempt(s)\n", attempts);
-  EXPECT_NE(log("sidecar").find("ack of gyro #2 by shore-op accepted"), std::string::npos)
+  EXPECT_NE(log("sidecar").find("ack of gyro #2 by shore:shore-op accepted"), std::string::npos)
       << log("sidecar");
   EXPECT_TRUE(read_monitor_until(shore, &mon, seconds(10), t0_, [](const MonitorLog& l) {
     return l.has(kMmsi, "gyro", "acknowledged");
@@ -316,9 +352,9 @@ TEST_F(ServiceSecurity, ReadOnlyObserverReadsButCannotAcknowledge) {
   EXPECT_EQ(shore.of(kMmsi, "accelerometer").at(0).sequence, 1u);
   // (control: the same ack by the shore identity is accepted)
   int attempts = 0;
-  EXPECT_EQ(
-      shore_ack(kM + ":accelerometer:1", "ack of accelerometer #1 by shore-op accepted", &attempts),
-      0)
+  EXPECT_EQ(shore_ack(kM + ":accelerometer:1", "ack of accelerometer #1 by shore:shore-op accepted",
+                      &attempts),
+            0)
       << log("ack1") << log("sidecar");
   stop_sidecar();
 }
@@ -413,6 +449,113 @@ TEST_F(ServiceSecurity, ParticipantsWithoutAValidIdentityCanNeitherReadNorInject
   EXPECT_EQ(number_before(stopped, " rejected"), 0) << stopped;
   EXPECT_EQ(number_before(stopped, " samples of other vessels skipped"), 0) << stopped;
   EXPECT_EQ(log("sidecar").find("2 INS writer(s)"), std::string::npos) << log("sidecar");
+}
+
+TEST_F(ServiceSecurity, AVesselIdentityCanNeitherPublishForAnotherVesselNorHideItsAlarm) {
+  // GIVEN the secured sidecar of vessel kMmsi after the voyage (accelerometer #1 raised), watched
+  // by the shore
+  start_sidecar();
+  ChildProcess& shore = start("shore", fleet_id("shore"), {"monitor", "--json"});
+  ASSERT_TRUE(wait_for_log("sidecar", "1 fault-event reader(s)", seconds(30))) << log("sidecar");
+  run_voyage();
+  MonitorLog mon;
+  ASSERT_TRUE(read_monitor_until(shore, &mon, seconds(15), t0_, [](const MonitorLog& l) {
+    return l.has(kMmsi, "accelerometer", "raised");
+  })) << mon.dump();
+  // WHEN vessel2's valid identity starts a sidecar for vessel kMmsi, in kMmsi's partition or in a
+  // wildcard partition
+  const std::string cfg = dir_ + "forger.yaml";
+  {
+    std::ofstream f(cfg);
+    f << slurp(kSource + "/config/scenarios/paper.yaml") << "\nservice:\n  mmsi: " << kMmsi
+      << "\n  state_dir: \"\"\n";
+  }
+  for (const std::string& vessel : {kM, std::string("*")}) {
+    SCOPED_TRACE("partition vessel-" + vessel);
+    const std::string name = vessel == kM ? "forger_own" : "forger_wild";
+    const int code =
+        run(name, fleet_id("vessel2"), {"run", "--config", cfg}, seconds(30), nullptr, vessel);
+    // THEN access control refuses its writers: it cannot start
+    EXPECT_NE(code, 0) << log(name);
+    EXPECT_NE(log(name).find("partition not found in rule"), std::string::npos) << log(name);
+  }
+  // WHEN vessel2's identity, in its own partition (which it may), writes kMmsi's accelerometer
+  // instance `normal` and its gyro `acknowledged` with sequences far ahead
+  ChildProcess& forger = start_probe("forger_probe", fleet_id("vessel2"), "publish-faults",
+                                     {"--vessels", "1", "--mmsi-base", kM, "--sensors", "2",
+                                      "--state", "0", "--sequence", "100", "--timeout", "60"},
+                                     kO);
+  ASSERT_TRUE(forger.read_line(milliseconds(20000)).has_value()) << log("forger_probe");
+  // THEN the running shore refuses both, naming the vessel, the sensor and the writer's identity
+  std::vector<std::string> lines;
+  const auto deadline = Clock::now() + seconds(20);
+  int refused = 0;
+  while (refused < 2 && Clock::now() < deadline) {
+    const auto line = shore.read_line(milliseconds(500));
+    if (!line) continue;
+    lines.push_back(*line);
+    if (line->find("\"type\":\"conflict\",\"mmsi\":" + kM) != std::string::npos &&
+        line->find("\"verdict\":\"refused\",\"why\":\"writer confined to another vessel\"") !=
+            std::string::npos &&
+        line->find("(identity vessel2) [partition " + partition_ + kO + "]") != std::string::npos) {
+      ++refused;
+    }
+    mon.add(*line, now());
+  }
+  std::string all;
+  for (const auto& l : lines) all += l + "\n";
+  EXPECT_EQ(refused, 2) << all << log("shore");
+  EXPECT_NE(log("shore").find("CONFLICT vessel " + kM + " accelerometer: writer "),
+            std::string::npos)
+      << log("shore");
+  EXPECT_EQ(mon.of(kMmsi, "accelerometer").back().state, "raised") << mon.dump();
+  EXPECT_EQ(mon.of(kMmsi, "accelerometer").back().sequence, 1u) << mon.dump();
+  // AND a shore monitor that joins now, when both writers' histories arrive at once, shows the
+  // sidecar's states
+  const MonitorLog late = latched("late_shore", fleet_id("shore"), 2, 10);
+  ASSERT_EQ(late.of(kMmsi, "accelerometer").size(), 1u) << late.dump() << log("late_shore");
+  EXPECT_EQ(late.of(kMmsi, "accelerometer").at(0).state, "raised");
+  EXPECT_EQ(late.of(kMmsi, "accelerometer").at(0).sequence, 1u);
+  EXPECT_EQ(late.of(kMmsi, "gyro").at(0).state, "cleared");
+  forger.signal(SIGTERM);
+  stop_sidecar();
+}
+
+TEST_F(ServiceSecurity, AShoreIdentityCannotAcknowledgeAVesselItIsNotGranted) {
+  // GIVEN the secured sidecar after the voyage: accelerometer #1 raised
+  start_sidecar();
+  run_voyage();
+  // WHEN shore2, granted vessel kOther only, acknowledges kMmsi's accelerometer event
+  const int code = run("shore2_ack", fleet_id("shore2"),
+                       {"monitor", "--ack", kM + ":accelerometer:1", "--operator", "shore2-op",
+                        "--discovery-timeout", "5"},
+                       seconds(40));
+  // THEN access control refuses it the ack writer into kMmsi's partition; the sidecar hears nothing
+  EXPECT_EQ(code, 1) << log("shore2_ack");
+  EXPECT_NE(log("shore2_ack").find("cannot acknowledge vessel " + kM), std::string::npos)
+      << log("shore2_ack");
+  EXPECT_NE(log("shore2_ack").find("partition not found in rule"), std::string::npos)
+      << log("shore2_ack");
+  EXPECT_EQ(log("sidecar").find("ack of"), std::string::npos) << log("sidecar");
+  // AND the operator id of an accepted ack is the authenticated identity's, whatever the writer
+  // claims: shore (granted kMmsi) claiming to be "captain"
+  int attempts = 0;
+  std::string code_log;
+  int rc = -1;
+  for (attempts = 1; attempts <= 3; ++attempts) {
+    const std::string name = "ack" + std::to_string(attempts);
+    rc = run(name, fleet_id("shore"),
+             {"monitor", "--ack", kM + ":accelerometer:1", "--operator", "captain"}, seconds(40));
+    if (log("sidecar").find("accepted") != std::string::npos ||
+        log(name).find("no confirmation from the sidecar") == std::string::npos) {
+      break;
+    }
+  }
+  EXPECT_EQ(rc, 0) << log("sidecar");
+  EXPECT_NE(log("sidecar").find("ack of accelerometer #1 by shore:captain accepted"),
+            std::string::npos)
+      << log("sidecar");
+  stop_sidecar();
 }
 
 }  // namespace
