@@ -25,6 +25,7 @@
 #include "commands.hpp"
 #include "dds_options.hpp"
 #include "instance_owners.hpp"
+#include "usv_fdi/core/text.hpp"
 #include "usv_fdi/dds_service/convert.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/jsonl.hpp"
@@ -141,7 +142,7 @@ std::string json_status(const VesselStatus& v, double heard_age) {
      << ",\"age_s\":" << io::json_number(wall_now() - v.written)
      << ",\"heard_age_s\":" << io::json_number(heard_age)
      << ",\"alive\":" << (v.alive ? "true" : "false")
-     << ",\"message\":" << io::json_string(s.message().to_string()) << "}";
+     << ",\"message\":" << io::json_string(escape_text(s.message().to_string())) << "}";
   return os.str();
 }
 
@@ -216,7 +217,7 @@ void print_table(const InstanceOwners<RowKey, Row>& rows,
         heard_line(mmsi, live, !vs->alive).c_str(), s.stamp(),
         s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0], s.a()[1],
         s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
-        static_cast<unsigned long long>(s.dropped()), s.message().c_str());
+        static_cast<unsigned long long>(s.dropped()), escape_text(s.message().to_string()).c_str());
     std::printf("  %s\n", inputs_line(s).c_str());
   }
   std::fflush(stdout);
@@ -292,7 +293,7 @@ std::string writer_name(const dds::DdsContext& ctx, const fdds::InstanceHandle_t
     for (const auto& p : w->partitions) parts += (parts.empty() ? "" : ",") + p;
     os << " [partition " << (parts.empty() ? std::string("<default>") : parts) << "]";
   }
-  return os.str();
+  return escape_text(os.str());  // names and partitions come from the peer
 }
 
 /// The FaultEvent and FdiStatus side of the monitor. The FdiStatus reader exists even without
@@ -593,7 +594,7 @@ bool send_ack(fdds::DataWriter& w, FleetView& view, const MonitorArgs& a, fdi::F
                           std::to_string(ack.sequence());
   ack.stamp(wall_now());
   dds::write(w, ack);
-  spdlog::info("ack sent: {} by {}", who, a.operator_id);
+  spdlog::info("ack sent: {} by {}", who, escape_text(a.operator_id));
   // Confirmed when the instance moves from the acknowledged sequence past it, to an
   // acknowledged state. If the latched state is already past it, the ack is stale: the
   // sidecar refuses it, no need to wait.

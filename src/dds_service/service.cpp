@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "usv_fdi/core/text.hpp"
 #include "usv_fdi/dds_service/convert.hpp"
 
 namespace usvfdi::service {
@@ -43,7 +44,8 @@ class FdiService::Listener : public DataReaderListener {
         // Under DDS Security the operator is the writer's authenticated identity, not what the
         // sample claims.
         if (peers_ != nullptr) {
-          in.who = dds::operator_of(peers_->subject_of(info.publication_handle), in.who);
+          in.who = escape_text(dds::operator_of(peers_->subject_of(info.publication_handle),
+                                                a.operator_id().to_string()));
         }
         return p_->push_ack(in);
       });
