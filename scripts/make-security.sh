@@ -42,6 +42,8 @@
 #                          name (and OUT) is a foreign CA whose identities must be refused
 #   --subject-org ORG      O= of every subject (default "usv-fdi test fleet")
 #   --days N               validity of certificates and grants (default 30)
+#   --grant-seconds N      the grants expire N seconds from now instead (tests of expiry; the
+#                          certificates keep --days)
 #   --path-prefix DIR      directory the files will be read from at run time, as written into
 #                          security_profiles.xml (default: OUT itself; e.g. /etc/usv-fdi/security
 #                          when OUT is mounted there in a container)
@@ -68,6 +70,7 @@ prefix=""
 force=0
 peers=""
 part_prefix=""
+grant_seconds=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --identity) [ $# -ge 2 ] || die "--identity needs ROLE:NAME"; identities+=("$2"); shift 2 ;;
@@ -76,6 +79,7 @@ while [ $# -gt 0 ]; do
     --days) [ $# -ge 2 ] || die "--days needs a value"; days="$2"; shift 2 ;;
     --path-prefix) [ $# -ge 2 ] || die "--path-prefix needs a value"; prefix="$2"; shift 2 ;;
     --initial-peers) [ $# -ge 2 ] || die "--initial-peers needs a value"; peers="$2"; shift 2 ;;
+    --grant-seconds) [ $# -ge 2 ] || die "--grant-seconds needs a value"; grant_seconds="$2"; shift 2 ;;
     --partition-prefix) [ $# -ge 2 ] || die "--partition-prefix needs a value"; part_prefix="$2"; shift 2 ;;
     --force) force=1; shift ;;
     *) die "unknown option '$1'" ;;
@@ -84,6 +88,7 @@ done
 [ ${#identities[@]} -gt 0 ] || identities=(vessel:vessel:257000001 sensors:sensors:257000001 shore:shore:'*' observer:observer)
 case "$part_prefix" in *[!A-Za-z0-9_.-]*) die "--partition-prefix may hold only A-Z a-z 0-9 _ . - (not '$part_prefix')" ;; esac
 case "$days" in '' | *[!0-9]* | 0) die "--days must be a positive whole number, not '$days'" ;; esac
+case "$grant_seconds" in *[!0-9]* | 0) die "--grant-seconds must be a positive whole number, not '$grant_seconds'" ;; esac
 peer_list=()
 if [ -n "$peers" ]; then
   IFS=, read -r -a peer_list <<<"$peers"
@@ -217,6 +222,7 @@ allow_rules() { # allow_rules ROLE VESSELS -> the <allow_rule> of the role
 
 not_before="$(date -u -d '-1 day' +%Y-%m-%dT%H:%M:%S)"
 not_after="$(date -u -d "+$days days" +%Y-%m-%dT%H:%M:%S)"
+[ -z "$grant_seconds" ] || not_after="$(date -u -d "+$grant_seconds seconds" +%Y-%m-%dT%H:%M:%S)"
 
 # --- identities ----------------------------------------------------------------------------
 profiles="$out/security_profiles.xml"

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "credentials.hpp"
 #include "dds_options.hpp"
 #include "instance_owners.hpp"
 #include "usv_fdi/core/text.hpp"
@@ -717,6 +718,18 @@ int run_monitor(const MonitorArgs& a) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
+  CredentialExpiry expiry;
+  try {
+    expiry = credential_expiry(cfg.participant_profile);
+  } catch (const std::exception& e) {
+    spdlog::error("DDS Security: {}", e.what());
+    return kExitConfig;
+  }
+  if (expiry.secure()) spdlog::info("{}", validity_message(expiry));
+  if (expiry.expired(wall_now())) {
+    spdlog::error("{}", expired_message(expiry));
+    return kExitFailure;
+  }
   const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
   if (!a.acks.empty()) {
     const int rc = send_acks(*ctx, *view, a, acks);
@@ -730,6 +743,10 @@ int run_monitor(const MonitorArgs& a) {
     if (changed && !a.json && !a.once) {
       print_table(view->rows(), view->vessels(), view->liveness(), view->conflicts());
       printed = true;
+    }
+    if (expiry.expired(wall_now())) {  // Fast DDS would keep the session open
+      spdlog::error("{}", expired_message(expiry));
+      return kExitFailure;
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     const bool enough = a.expect > 0 && static_cast<int>(view->rows().size()) >= a.expect;

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -556,6 +557,68 @@ TEST_F(ServiceSecurity, AShoreIdentityCannotAcknowledgeAVesselItIsNotGranted) {
             std::string::npos)
       << log("sidecar");
   stop_sidecar();
+}
+
+TEST_F(ServiceSecurity, ExpiredCredentialsEndTheSessionsAlreadyOpen) {
+  // GIVEN a PKI whose grants expire kGrant s from now (certificates valid for days)
+  constexpr int kGrant = 30;
+  const fs::path pki = fs::path(dir_) / "short";
+  {
+    ChildProcess p({USV_FDI_MAKE_SECURITY, pki.string(), "--partition-prefix", partition_prefix(),
+                    "--grant-seconds", std::to_string(kGrant), "--identity", "vessel:vessel:" + kM,
+                    "--identity", "shore:shore:" + kM});
+    const std::string out = p.read_all(milliseconds(60000));
+    ASSERT_EQ(p.wait_exit(milliseconds(5000)).value_or(-1), 0) << out;
+  }
+  // The grant's own <not_after> (UTC, whole seconds)
+  const std::string grant = slurp((pki / "vessel" / "permissions.xml").string());
+  const std::size_t at = grant.find("<not_after>");
+  ASSERT_NE(at, std::string::npos) << grant;
+  std::tm tm{};
+  ASSERT_NE(strptime(grant.c_str() + at + 11, "%Y-%m-%dT%H:%M:%S", &tm), nullptr) << grant;
+  const auto expires = std::chrono::system_clock::from_time_t(timegm(&tm));
+  const Identity vessel{(pki / "security_profiles.xml").string(), "usv_fdi_secure_vessel_loopback"};
+  const Identity shore{(pki / "security_profiles.xml").string(), "usv_fdi_secure_shore_loopback"};
+  // AND a sidecar and a shore monitor whose session is open (the shore receives the status)
+  const std::string cfg = dir_ + "sidecar.yaml";
+  {
+    std::ofstream f(cfg);
+    f << slurp(kSource + "/config/scenarios/paper.yaml") << "\nservice:\n  mmsi: " << kMmsi
+      << "\n  status_rate: 5\n  input_timeout: 60\n  state_dir: \"\"\n";
+  }
+  ChildProcess& side = start("sidecar", vessel, {"run", "--config", cfg});
+  ChildProcess& mon = start("shore", shore, {"monitor", "--json", "--status"});
+  MonitorLog seen;
+  const bool open =
+      read_monitor_until(mon, &seen, seconds(kGrant - 5), t0_,
+                         [](const MonitorLog& l) { return l.last_status(kMmsi) != nullptr; });
+  const double left =
+      std::chrono::duration<double>(expires - std::chrono::system_clock::now()).count();
+  ASSERT_TRUE(open) << "no session before the grant expired: the machine was starved (" << left
+                    << " s of the grant left)\n"
+                    << log("sidecar") << log("shore");
+  EXPECT_NE(log("sidecar").find("DDS Security credentials valid until"), std::string::npos)
+      << log("sidecar");
+  EXPECT_NE(log("sidecar").find("first to expire: the permissions grant"), std::string::npos);
+  // WHEN the grants expire
+  // THEN both leave the domain within a few of their loop periods (0.5 s, 0.2 s) of the expiry,
+  // saying why, with exit code 1 (an orchestrator restarts them, with renewed credentials or not)
+  const auto limit = seconds(kGrant + 30);
+  const auto side_code = side.wait_exit(std::chrono::duration_cast<milliseconds>(limit));
+  const double side_late =
+      std::chrono::duration<double>(std::chrono::system_clock::now() - expires).count();
+  const auto mon_code = mon.wait_exit(seconds(10));
+  const double mon_late =
+      std::chrono::duration<double>(std::chrono::system_clock::now() - expires).count();
+  std::printf("after the grant expired: sidecar left %.2f s, monitor %.2f s later\n", side_late,
+              mon_late);
+  EXPECT_EQ(side_code.value_or(-1), 1) << log("sidecar");
+  EXPECT_EQ(mon_code.value_or(-1), 1) << log("shore");
+  EXPECT_GE(side_late, 0.0);
+  for (const char* who : {"sidecar", "shore"}) {
+    EXPECT_NE(log(who).find("credentials expired: the permissions grant "), std::string::npos)
+        << log(who);
+  }
 }
 
 }  // namespace
