@@ -49,8 +49,8 @@ TEST(Injection, ANewlineInTheOperatorIdDoesNotForgeASidecarLogLine) {
   EXPECT_EQ(log.find('\x1b'), std::string::npos) << log;
   // AND the monitor's view of the acknowledged event carries the escaped text, nothing raw
   std::string out;
-  const auto mon =
-      f.run_to_end("table", {"monitor", "--once", "--duration", "3"}, seconds(20), &out);
+  const auto mon = f.run_to_end("table", {"monitor", "--once", "--expect", "1", "--duration", "15"},
+                                seconds(20), &out);
   ASSERT_TRUE(mon.has_value());
   EXPECT_NE(out.find("acknowledged by m\\nusv-fdi"), std::string::npos) << out;
   EXPECT_EQ(out.find('\r'), std::string::npos) << out;
