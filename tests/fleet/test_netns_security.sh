@@ -13,28 +13,9 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 probe="$1"
 qos="$2"
 make_security="$3"
-# shellcheck source=netns.sh
-source "$here/netns.sh"
-if ! reason="$(fleet_netns_check)"; then
-  echo "SKIP: $reason"
-  exit 77
-fi
-
-name="sc$(( $$ % 100000 ))"
-work="$(mktemp -d)"
-cleanup() {
-  fleet_netns_down "$name"
-  rm -rf "$work"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do
-    [ -f "$f" ] && { echo "--- $(basename "$f")"; tail -n 20 "$f"; }
-  done
-  exit 1
-}
+# shellcheck source=netns_preamble.sh
+source "$here/netns_preamble.sh"
+netns_test_begin sc 20
 
 fleet_netns_up "$name" 2 || fail "namespaces not made"
 peers="$(fleet_netns_addr "$name" shore),$(fleet_netns_addr "$name" v1),$(fleet_netns_addr "$name" v2)"
