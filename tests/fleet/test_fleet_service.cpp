@@ -269,7 +269,10 @@ std::string run_fleet(ServiceFleet& f, const char* discovery) {
   int attempts = 0;
   std::optional<int> ack;
   std::string ack_log;
-  const std::string accepted = "ack of accelerometer #2 by shore-op accepted";
+  // Under DDS Security the operator id is the shore identity's CN with the claimed id appended.
+  const bool secure = std::string(discovery).rfind("secure", 0) == 0;
+  const std::string accepted = std::string("ack of accelerometer #2 by ") +
+                               (secure ? "shore:shore-op" : "shore-op") + " accepted";
   while (attempts < 3) {
     const std::string name = "ack" + std::to_string(++attempts);
     ack = f.run_on_shore(name,
