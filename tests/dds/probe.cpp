@@ -66,6 +66,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include "probe_common.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 
 namespace {
@@ -75,11 +76,11 @@ using usv_fdi::dds::DdsConfig;
 using usv_fdi::dds::DdsContext;
 namespace profiles = usv_fdi::dds::profiles;
 using Clock = std::chrono::steady_clock;
-
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "signal flag must be lock free");
-
-extern "C" void on_signal(int) { g_stop.store(true); }  // no I/O, async-signal-safe
+using usv_fdi::test_support::probe::deadline_after;
+using usv_fdi::test_support::probe::g_stop;
+using usv_fdi::test_support::probe::install_signal_handlers;
+using usv_fdi::test_support::probe::parse_unsigned;
+using usv_fdi::test_support::probe::UsageError;
 
 struct Options {
   std::string mode;
@@ -100,21 +101,6 @@ struct Options {
   std::string script;
   unsigned delay_ms = 200;
 };
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-unsigned long parse_unsigned(const std::string& flag, const std::string& value) {
-  try {
-    std::size_t used = 0;
-    const unsigned long v = std::stoul(value, &used);
-    if (used != value.size()) throw std::invalid_argument(value);
-    return v;
-  } catch (const std::exception&) {
-    throw UsageError(flag + ": not an unsigned integer: '" + value + "'");
-  }
-}
 
 Options parse(int argc, char** argv) {
   if (argc < 2) {
@@ -182,20 +168,6 @@ Options parse(int argc, char** argv) {
   if (o.dds.profiles_file.empty()) throw UsageError("--profiles is required");
   if (o.mode == "read-faults" && o.expect == 0) throw UsageError("--expect must be > 0");
   return o;
-}
-
-Clock::time_point deadline_after(double seconds) {
-  return Clock::now() +
-         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-}
-
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGINT, &sa, nullptr);
 }
 
 fdi::FaultEvent make_event(std::uint32_t mmsi, unsigned sensor, unsigned state,
