@@ -42,10 +42,11 @@ participant() {
 
 if [ "$secure" -eq 1 ]; then
   peers="$shore_ip"
-  ids="--identity shore:shore"
+  ids="--identity 'shore:shore:*'"
   for i in $(seq 1 "$n"); do
     peers="$peers,$subnet.$((10 + i))"
-    ids="$ids --identity vessel:vessel$i --identity sensors:vessel$i-sim"
+    m=$((257000000 + i))
+    ids="$ids --identity vessel:vessel$i:$m --identity sensors:vessel$i-sim:$m"
   done
   cat <<YAML
 # usv-fdi simulated fleet with DDS Security: $n vessel(s), shore monitor; unicast discovery.

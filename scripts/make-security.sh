@@ -6,6 +6,7 @@
 #   OUT/governance.xml, .p7s       config/security/governance.xml, signed with `openssl smime`
 #   OUT/<name>/cert.pem, key.pem   identity of each participant, signed by the CA
 #   OUT/<name>/permissions.xml,.p7s  its grant (role's rights, see config/security/permissions.xml.in)
+#   OUT/<name>/role, vessels       its role and the vessels it is bound to / granted (one a line)
 #   OUT/security_profiles.xml      Fast DDS XML participant profiles that enable all three plugins:
 #                                    usv_fdi_secure_<name>           builtin transports (SHM+UDPv4)
 #                                    usv_fdi_secure_<name>_loopback  UDPv4 on 127.0.0.1 only
@@ -19,12 +20,30 @@
 # addresses (shore and vessels), see docker/README.md.
 #
 # Usage: scripts/make-security.sh OUT [options]
-#   --identity ROLE:NAME   add an identity (repeatable); ROLE is vessel, sensors, shore or observer.
-#                          Default: vessel:vessel sensors:sensors shore:shore observer:observer
+#   --identity ROLE:NAME[:VESSELS]
+#                          add an identity (repeatable); ROLE is vessel, sensors, shore or observer.
+#                          VESSELS ties it to vessels (MMSIs, 1..999999999), and every right of a
+#                          vessel-bound role is confined to the vessel's partition PREFIXvessel-<MMSI>:
+#                            vessel:NAME:MMSI     the sidecar of that one vessel: publishes its fault
+#                                                 events and status, reads its INS, rudder and acks,
+#                                                 only in its own partition (required: one MMSI)
+#                            sensors:NAME:MMSI    that vessel's INS/rudder gateway: publishes INS and
+#                                                 rudder in its partition only (required: one MMSI)
+#                            shore:NAME:M1,M2,..  reads every vessel (PREFIXvessel-*), acknowledges
+#                                                 only the vessels listed; shore:NAME:* acknowledges
+#                                                 every vessel (required: the list or *)
+#                            observer:NAME        reads every vessel, writes nothing
+#                          Default: vessel:vessel:257000001 sensors:sensors:257000001 shore:shore:*
+#                          observer:observer
+#   --partition-prefix P   prefix of the vessel partitions (default none: vessel-<MMSI>); the
+#                          processes must then use P + vessel-<MMSI> (sidecar, sensors) and
+#                          P + vessel-* (shore, observer)
 #   --ca-name NAME         CN of the CA (default "usv-fdi test CA"); a second PKI made with another
 #                          name (and OUT) is a foreign CA whose identities must be refused
 #   --subject-org ORG      O= of every subject (default "usv-fdi test fleet")
 #   --days N               validity of certificates and grants (default 30)
+#   --grant-seconds N      the grants expire N seconds from now instead (tests of expiry; the
+#                          certificates keep --days)
 #   --path-prefix DIR      directory the files will be read from at run time, as written into
 #                          security_profiles.xml (default: OUT itself; e.g. /etc/usv-fdi/security
 #                          when OUT is mounted there in a container)
@@ -50,6 +69,8 @@ days=30
 prefix=""
 force=0
 peers=""
+part_prefix=""
+grant_seconds=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --identity) [ $# -ge 2 ] || die "--identity needs ROLE:NAME"; identities+=("$2"); shift 2 ;;
@@ -58,12 +79,16 @@ while [ $# -gt 0 ]; do
     --days) [ $# -ge 2 ] || die "--days needs a value"; days="$2"; shift 2 ;;
     --path-prefix) [ $# -ge 2 ] || die "--path-prefix needs a value"; prefix="$2"; shift 2 ;;
     --initial-peers) [ $# -ge 2 ] || die "--initial-peers needs a value"; peers="$2"; shift 2 ;;
+    --grant-seconds) [ $# -ge 2 ] || die "--grant-seconds needs a value"; grant_seconds="$2"; shift 2 ;;
+    --partition-prefix) [ $# -ge 2 ] || die "--partition-prefix needs a value"; part_prefix="$2"; shift 2 ;;
     --force) force=1; shift ;;
     *) die "unknown option '$1'" ;;
   esac
 done
-[ ${#identities[@]} -gt 0 ] || identities=(vessel:vessel sensors:sensors shore:shore observer:observer)
+[ ${#identities[@]} -gt 0 ] || identities=(vessel:vessel:257000001 sensors:sensors:257000001 shore:shore:'*' observer:observer)
+case "$part_prefix" in *[!A-Za-z0-9_.-]*) die "--partition-prefix may hold only A-Z a-z 0-9 _ . - (not '$part_prefix')" ;; esac
 case "$days" in '' | *[!0-9]* | 0) die "--days must be a positive whole number, not '$days'" ;; esac
+case "$grant_seconds" in *[!0-9]* | 0) die "--grant-seconds must be a positive whole number, not '$grant_seconds'" ;; esac
 peer_list=()
 if [ -n "$peers" ]; then
   IFS=, read -r -a peer_list <<<"$peers"
@@ -76,16 +101,39 @@ for f in governance.xml permissions.xml.in; do
   [ -r "$templates/$f" ] || die "missing template $templates/$f"
 done
 
-# Identities: ROLE:NAME with unique names (NAME becomes the certificate's CN and a directory).
+# Identities: ROLE:NAME[:VESSELS] with unique names (NAME becomes the certificate's CN and a
+# directory). id_role, id_name, id_vessels: parsed, by position.
 declare -A seen=()
+id_role=()
+id_name=()
+id_vessels=()
 for id in "${identities[@]}"; do
-  role="${id%%:*}"
-  name="${id#*:}"
-  [ "$role" != "$id" ] && [ -n "$name" ] || die "--identity '$id': expected ROLE:NAME"
+  IFS=: read -r role name vessels extra <<<"$id"
+  [ -n "$role" ] && [ -n "${name:-}" ] && [ -z "${extra:-}" ] || die "--identity '$id': expected ROLE:NAME[:VESSELS]"
   case "$role" in vessel | sensors | shore | observer) ;; *) die "--identity '$id': unknown role '$role' (vessel, sensors, shore, observer)" ;; esac
   case "$name" in *[!A-Za-z0-9_.-]*) die "--identity '$id': NAME may hold only A-Z a-z 0-9 _ . -" ;; esac
   [ -z "${seen[$name]:-}" ] || die "--identity '$id': name '$name' given twice"
   seen[$name]=1
+  vessels="${vessels:-}"
+  case "$role" in
+    vessel | sensors)
+      [ -n "$vessels" ] || die "--identity '$id': a $role identity is bound to one vessel: give $role:$name:MMSI"
+      [[ "$vessels" =~ ^[1-9][0-9]{0,8}$ ]] || die "--identity '$id': '$vessels' is not one MMSI (1..999999999)"
+      ;;
+    shore)
+      [ -n "$vessels" ] || die "--identity '$id': say which vessels the shore may acknowledge: shore:$name:MMSI[,MMSI...] or shore:$name:*"
+      if [ "$vessels" != "*" ]; then
+        IFS=, read -r -a list <<<"$vessels"
+        for m in "${list[@]}"; do
+          [[ "$m" =~ ^[1-9][0-9]{0,8}$ ]] || die "--identity '$id': '$m' is not an MMSI (1..999999999)"
+        done
+      fi
+      ;;
+    observer) [ -z "$vessels" ] || die "--identity '$id': an observer reads every vessel and writes nothing: give observer:$name" ;;
+  esac
+  id_role+=("$role")
+  id_name+=("$name")
+  id_vessels+=("$vessels")
 done
 
 case "$(realpath -m "$out")" in / | "$(realpath -m "$root")" | "$(realpath -m "${HOME:-/}")")
@@ -132,26 +180,49 @@ topics() { # topics NAME... -> <topic> elements
   local t
   for t in "$@"; do printf '            <topic>usv_fdi/%s</topic>\n' "$t"; done
 }
-rule() { # rule publish|subscribe TOPIC...
-  local kind="$1"
-  shift
+partition_elems() { # partition_elems PARTITION... -> <partition> elements
+  local p
+  for p in "$@"; do printf '            <partition>%s</partition>\n' "$p"; done
+}
+rule() { # rule publish|subscribe "PARTITION..." TOPIC...
+  local kind="$1" parts="$2"
+  shift 2
+  local -a plist
+  read -r -a plist <<<"$parts"
   printf '        <%s>\n          <topics>\n%s\n          </topics>\n' "$kind" "$(topics "$@")"
-  printf '          <partitions>\n            <partition></partition>\n            <partition>*</partition>\n          </partitions>\n'
+  printf '          <partitions>\n%s\n          </partitions>\n' "$(partition_elems "${plist[@]}")"
   printf '        </%s>\n' "$kind"
 }
-allow_rules() { # allow_rules ROLE -> the <allow_rule> of the role
+vessel_partitions() { # vessel_partitions VESSELS -> the partition names (space separated)
+  local m out=""
+  if [ "$1" = "*" ]; then
+    echo "${part_prefix}vessel-*"
+    return
+  fi
+  IFS=, read -r -a list <<<"$1"
+  for m in "${list[@]}"; do out="$out ${part_prefix}vessel-$m"; done
+  echo "${out# }"
+}
+allow_rules() { # allow_rules ROLE VESSELS -> the <allow_rule> of the role
+  # Partition names are matched by the Access-Permissions plugin as patterns (fnmatch) of the
+  # permissions against the partitions an endpoint asks for: a vessel's literal partition allows
+  # that partition only (not "vessel-*", not the default partition "").
+  local own every
+  own="$(vessel_partitions "$2")"
+  every="${part_prefix}vessel-*"
   printf '      <allow_rule>\n        <domains>\n          <id_range>\n            <min>0</min>\n            <max>232</max>\n          </id_range>\n        </domains>\n'
   case "$1" in
-    vessel) rule publish fault_event status; rule subscribe ins rudder fault_ack ;;
-    sensors) rule publish ins rudder ;;
-    shore) rule publish fault_ack; rule subscribe fault_event status ;;
-    observer) rule subscribe fault_event status ;;
+    vessel) rule publish "$own" fault_event status; rule subscribe "$own" ins rudder fault_ack ;;
+    sensors) rule publish "$own" ins rudder ;;
+    shore) rule publish "$own" fault_ack; rule subscribe "$every" fault_event status ;;
+    observer) rule subscribe "$every" fault_event status ;;
   esac
   printf '      </allow_rule>'
 }
 
 not_before="$(date -u -d '-1 day' +%Y-%m-%dT%H:%M:%S)"
 not_after="$(date -u -d "+$days days" +%Y-%m-%dT%H:%M:%S)"
+[ -z "$grant_seconds" ] || not_after="$(date -u -d "+$grant_seconds seconds" +%Y-%m-%dT%H:%M:%S)"
 
 # --- identities ----------------------------------------------------------------------------
 profiles="$out/security_profiles.xml"
@@ -190,9 +261,10 @@ security_properties() { # security_properties NAME
   printf '          </properties>\n        </propertiesPolicy>\n'
 }
 
-for id in "${identities[@]}"; do
-  role="${id%%:*}"
-  name="${id#*:}"
+for i in "${!id_role[@]}"; do
+  role="${id_role[i]}"
+  name="${id_name[i]}"
+  vessels="${id_vessels[i]}"
   dir="$out/$name"
   mkdir -p "$dir"
   quiet openssl ecparam -name prime256v1 -genkey -noout -out "$dir/key.pem"
@@ -205,7 +277,7 @@ for id in "${identities[@]}"; do
   rm -f "$dir/cert.csr" "$dir/ext.cnf"
   chmod 0644 "$dir/cert.pem"
   subject="$(openssl x509 -in "$dir/cert.pem" -noout -subject -nameopt RFC2253 | sed 's/^subject=//')"
-  allow="$(allow_rules "$role")"
+  allow="$(allow_rules "$role" "$vessels")"
   # Substitute with awk (values may hold '/', '&' or spaces).
   awk -v name="$name" -v subject="$subject" -v nb="$not_before" -v na="$not_after" -v allow="$allow" '
     /^@ALLOW@$/ { print allow; next }
@@ -213,7 +285,8 @@ for id in "${identities[@]}"; do
   ' "$templates/permissions.xml.in" >"$dir/permissions.xml"
   sign "$dir/permissions.xml"
   printf '%s\n' "$role" >"$dir/role"
-  chmod 0644 "$dir/role"
+  printf '%s\n' "${vessels//,/$'\n'}" >"$dir/vessels"
+  chmod 0644 "$dir/role" "$dir/vessels"
   {
     variants=("" _loopback)
     [ ${#peer_list[@]} -eq 0 ] || variants+=(_unicast)
@@ -247,7 +320,7 @@ for id in "${identities[@]}"; do
       printf '      </rtps>\n    </participant>\n'
     done
   } >>"$profiles"
-  echo "make-security.sh: $role identity '$name': $subject"
+  echo "make-security.sh: $role identity '$name': $subject${vessels:+, vessels $vessels}"
 done
 rm -f "$out/ca/ca.srl"
 printf '  </profiles>\n</dds>\n' >>"$profiles"

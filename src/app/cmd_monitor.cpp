@@ -6,533 +6,150 @@
 // "last heard" time, and a vessel not heard for --silent-after s is flagged silent on a timer.
 #include <spdlog/spdlog.h>
 
-#include <fastdds/dds/core/condition/WaitSet.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/subscriber/DataReader.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
-#include <mutex>
-#include <optional>
-#include <set>
-#include <sstream>
+#include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "ack_protocol.hpp"
 #include "commands.hpp"
+#include "credentials.hpp"
 #include "dds_options.hpp"
-#include "usv_fdi/dds_service/convert.hpp"
+#include "fleet_view.hpp"
+#include "monitor_format.hpp"
+#include "usv_fdi/core/text.hpp"
 #include "usv_fdi/io/config.hpp"
-#include "usv_fdi/io/jsonl.hpp"
-#include "vessel_liveness.hpp"
 
 namespace usvfdi::app {
 namespace {
 
 namespace dds = usv_fdi::dds;
-namespace fdds = eprosima::fastdds::dds;
-using eprosima::fastrtps::types::ReturnCode_t;
 using Clock = std::chrono::steady_clock;
 
-struct MonitorArgs {
-  DdsCli dds;
-  std::vector<std::uint32_t> mmsi;  ///< filter (empty: every vessel)
-  bool json = false;
-  bool status = false;            ///< also show each vessel's FdiStatus
-  std::vector<std::string> acks;  ///< MMSI:SENSOR:SEQUENCE
-  std::string operator_id = "operator";
-  double ack_timeout = 5.0;         ///< wait for the sidecar's confirmation of an ack [s]
-  double discovery_timeout = 10.0;  ///< wait for a sidecar's ack reader [s]
-  double duration = 0.0;            ///< stop after this long (0: until a signal)
-  bool once = false;          ///< print the latched state after --duration (default 3 s) and exit
-  int expect = 0;             ///< stop once this many instances are known
-  double silent_after = 5.0;  ///< flag a vessel not heard for longer than this [s]
-};
-
-/// Wall-clock seconds since the epoch (the writer's source timestamps are on this clock).
-double wall_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-/// Monotonic seconds: the local receive times of "last heard".
-double mono_now() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
-
-struct Row {
-  std::uint32_t mmsi = 0;
-  FaultEvent ev;
-  double written = 0.0;           ///< the sidecar's write time (source timestamp) [s since epoch]
-  bool alive = true;              ///< false: the sidecar that published it is gone
-  fdds::InstanceHandle_t writer;  ///< the sidecar's FaultEvent writer
-};
-using RowKey = std::pair<std::uint32_t, int>;
-
-struct VesselStatus {
-  fdi::FdiStatus st;
-  double written = 0.0;
-  bool alive = true;
-  fdds::InstanceHandle_t writer;
-};
-
-std::string json_row(const Row& r, double heard_age) {
-  std::ostringstream os;
-  const FaultEvent& e = r.ev;
-  os << "{\"type\":\"fault\",\"mmsi\":" << r.mmsi << ",\"sensor\":\"" << to_string(e.sensor)
-     << "\",\"state\":\"" << to_string(e.state) << "\",\"kind\":\"" << to_string(e.kind)
-     << "\",\"c_a\":" << io::json_number(e.c_a) << ",\"c_g\":" << io::json_number(e.c_g)
-     << ",\"statistic\":" << io::json_number(e.statistic)
-     << ",\"threshold\":" << io::json_number(e.threshold)
-     << ",\"onset_time\":" << io::json_number(e.onset_time)
-     << ",\"detection_time\":" << io::json_number(e.detection_time)
-     << ",\"stamp\":" << io::json_number(e.t) << ",\"sequence\":" << e.sequence << ",\"a\":["
-     << io::json_number(e.A(0, 0)) << "," << io::json_number(e.A(0, 1)) << ","
-     << io::json_number(e.A(1, 0)) << "," << io::json_number(e.A(1, 1))
-     << "],\"age_s\":" << io::json_number(wall_now() - r.written)
-     << ",\"heard_age_s\":" << io::json_number(heard_age)
-     << ",\"alive\":" << (r.alive ? "true" : "false")
-     << ",\"message\":" << io::json_string(e.message) << "}";
-  return os.str();
-}
-
-/// One line on the inputs of a vessel: problems, counters, pauses.
-std::string inputs_line(const fdi::FdiStatus& s) {
-  std::string flags = input_flag_names(s.input_flags());
-  char counts[200];
-  std::snprintf(counts, sizeof counts,
-                "rejected timestamps %llu, invalid values %llu, gaps %llu, reordered %llu, queue "
-                "drops %llu",
-                static_cast<unsigned long long>(s.rejected_timestamps()),
-                static_cast<unsigned long long>(s.invalid_values()),
-                static_cast<unsigned long long>(s.gaps()),
-                static_cast<unsigned long long>(s.reordered()),
-                static_cast<unsigned long long>(s.dropped_inputs()));
-  std::string line = "inputs: " + (flags.empty() ? std::string("ok") : flags) + " (" + counts + ")";
-  line += s.identification_paused() == 0
-              ? std::string("; identification running")
-              : "; identification paused: " + pause_reason_names(s.identification_paused());
-  line += s.isolation_paused() == 0
-              ? std::string("; isolation running")
-              : "; isolation paused: " + pause_reason_names(s.isolation_paused());
-  return line;
-}
-
-std::string json_status(const VesselStatus& v, double heard_age) {
-  const fdi::FdiStatus& s = v.st;
-  std::ostringstream os;
-  os << "{\"type\":\"status\",\"mmsi\":" << s.mmsi() << ",\"stamp\":" << io::json_number(s.stamp())
-     << ",\"a\":[" << io::json_number(s.a()[0]) << "," << io::json_number(s.a()[1]) << ","
-     << io::json_number(s.a()[2]) << "," << io::json_number(s.a()[3])
-     << "],\"converged\":" << (s.converged() ? "true" : "false")
-     << ",\"armed\":" << (s.armed() ? "true" : "false")
-     << ",\"excitation\":" << io::json_number(s.excitation())
-     << ",\"ins_healthy\":" << (s.ins_healthy() ? "true" : "false")
-     << ",\"rudder_healthy\":" << (s.rudder_healthy() ? "true" : "false")
-     << ",\"samples\":" << s.samples() << ",\"dropped\":" << s.dropped()
-     << ",\"input_flags\":" << io::json_string_array(input_flag_names(s.input_flags()))
-     << ",\"rejected_timestamps\":" << s.rejected_timestamps()
-     << ",\"invalid_values\":" << s.invalid_values() << ",\"gaps\":" << s.gaps()
-     << ",\"reordered\":" << s.reordered() << ",\"dropped_inputs\":" << s.dropped_inputs()
-     << ",\"identification_paused\":"
-     << io::json_string_array(pause_reason_names(s.identification_paused()))
-     << ",\"isolation_paused\":" << io::json_string_array(pause_reason_names(s.isolation_paused()))
-     << ",\"age_s\":" << io::json_number(wall_now() - v.written)
-     << ",\"heard_age_s\":" << io::json_number(heard_age)
-     << ",\"alive\":" << (v.alive ? "true" : "false")
-     << ",\"message\":" << io::json_string(s.message().to_string()) << "}";
-  return os.str();
-}
-
-/// "vessel 257000001 (silent): last heard 7.2 s ago" (the start of a vessel's line).
-std::string heard_line(std::uint32_t mmsi, const VesselLiveness& live, bool gone) {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "vessel %u%s%s: last heard %.1f s ago", mmsi,
-                gone ? " (sidecar gone)" : "", live.silent(mmsi) ? " (silent)" : "",
-                live.age(mmsi, mono_now()));
-  return buf;
-}
-
-/// The line printed once when a vessel goes silent or is heard again.
-std::string change_line(const VesselLiveness::Change& c, double silent_after) {
-  char buf[160];
-  if (c.silent) {
-    std::snprintf(buf, sizeof buf, "vessel %u silent: nothing heard for %.1f s (> %g s)", c.mmsi,
-                  c.age, silent_after);
-  } else {
-    std::snprintf(buf, sizeof buf, "vessel %u heard again after %.1f s of silence", c.mmsi, c.gap);
-  }
-  return buf;
-}
-
-std::string json_change(const VesselLiveness::Change& c, double silent_after) {
-  std::ostringstream os;
-  os << "{\"type\":\"vessel\",\"mmsi\":" << c.mmsi
-     << ",\"silent\":" << (c.silent ? "true" : "false")
-     << ",\"heard_age_s\":" << io::json_number(c.age);
-  if (!c.silent) os << ",\"gap_s\":" << io::json_number(c.gap);
-  os << ",\"silent_after_s\":" << io::json_number(silent_after) << "}";
-  return os.str();
-}
-
-void print_table(const std::map<RowKey, Row>& rows,
-                 const std::map<std::uint32_t, VesselStatus>* vessels, const VesselLiveness& live) {
-  const double now = wall_now();
-  std::printf("%-10s %-13s %-21s %-8s %5s %5s %4s %8s %8s %7s  %s\n", "VESSEL", "SENSOR", "STATE",
-              "KIND", "C_A", "C_G", "SEQ", "ONSET[s]", "T[s]", "AGE[s]", "MESSAGE");
-  for (const auto& [key, r] : rows) {
-    std::string state = to_string(r.ev.state);
-    if (!r.alive) state += "?";  // the sidecar is gone: last known state
-    std::printf("%-10u %-13s %-21s %-8s %5.2f %5.2f %4llu %8.2f %8.2f %7.1f  %s\n", r.mmsi,
-                to_string(r.ev.sensor), state.c_str(), to_string(r.ev.kind), r.ev.c_a, r.ev.c_g,
-                static_cast<unsigned long long>(r.ev.sequence), r.ev.onset_time, r.ev.t,
-                now - r.written, r.ev.message.c_str());
-  }
-  std::printf("(%zu fault instances%s)\n", rows.size(),
-              std::any_of(rows.begin(), rows.end(), [](const auto& kv) { return !kv.second.alive; })
-                  ? "; '?': sidecar gone, last known state"
-                  : "");
-  // One line per vessel heard: how long ago; with --status also its FdiStatus.
-  for (const std::uint32_t mmsi : live.vessels()) {
-    const VesselStatus* vs = nullptr;
-    if (vessels != nullptr) {
-      const auto it = vessels->find(mmsi);
-      if (it != vessels->end()) vs = &it->second;
-    }
-    if (vs == nullptr) {
-      const bool gone = std::any_of(rows.begin(), rows.end(), [&](const auto& kv) {
-        return kv.second.mmsi == mmsi && !kv.second.alive;
-      });
-      std::printf("%s\n", heard_line(mmsi, live, gone).c_str());
-      continue;
-    }
-    const fdi::FdiStatus& s = vs->st;
-    std::printf(
-        "%s; t=%.1f s, %s%s, A=[%.4g %.4g; %.4g %.4g], %llu samples, %llu "
-        "dropped: %s\n",
-        heard_line(mmsi, live, !vs->alive).c_str(), s.stamp(),
-        s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0], s.a()[1],
-        s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
-        static_cast<unsigned long long>(s.dropped()), s.message().c_str());
-    std::printf("  %s\n", inputs_line(s).c_str());
-  }
+void print_table(const FleetView& view) {
+  const std::string t = format_table(view.rows(), view.vessels(), view.liveness(), view.conflicts(),
+                                     wall_now(), mono_now());
+  std::fputs(t.c_str(), stdout);
   std::fflush(stdout);
 }
 
-bool parse_ack(const std::string& spec, fdi::FaultAck* out, std::string* why) {
-  std::stringstream ss(spec);
-  std::string m, s, q;
-  if (!std::getline(ss, m, ':') || !std::getline(ss, s, ':') || !std::getline(ss, q) || m.empty() ||
-      q.empty()) {
-    *why = "--ack " + spec + ": expected MMSI:SENSOR:SEQUENCE (e.g. 257000001:gyro:3)";
-    return false;
-  }
-  Sensor sensor;
-  if (!parse_sensor(s, &sensor)) {
-    *why = "--ack " + spec + ": sensor '" + s + "' is not accelerometer, gyro or unknown";
-    return false;
-  }
-  try {
-    std::size_t pm = 0, pq = 0;
-    const unsigned long mmsi = std::stoul(m, &pm);
-    const unsigned long long seq = std::stoull(q, &pq);
-    if (pm != m.size() || pq != q.size() || mmsi == 0 || mmsi > 999999999ul || seq == 0) {
-      throw std::invalid_argument(spec);
+/// True when the latched state of some instance of the vessel is shown.
+bool has_vessel(const FleetView& view, std::uint32_t mmsi) {
+  bool found = false;
+  view.rows().for_each([&](const RowKey& key, const Row&) { found = found || key.first == mmsi; });
+  return found;
+}
+
+/// Sends one ack and waits for the sidecar's confirmation. Returns true if it was accepted.
+bool send_ack(fdds::DataWriter& w, FleetView& view, const MonitorArgs& a, const AckRequest& req,
+              bool* stop) {
+  const RowKey key{req.mmsi, static_cast<int>(req.sensor)};
+  const Row* row = view.row(key);
+  const std::string who = "MMSI " + std::to_string(req.mmsi) + " " + to_string(req.sensor) + " #" +
+                          std::to_string(req.sequence);
+  fdi::FaultAck ack;
+  ack.mmsi(req.mmsi);
+  ack.sensor(static_cast<std::uint8_t>(req.sensor));
+  ack.sequence(req.sequence);
+  ack.operator_id(a.operator_id.substr(0, 63).c_str());
+  ack.stamp(wall_now());
+  if (row != nullptr) ack.incarnation(row->ev.incarnation);  // else refused by the sidecar
+  dds::write(w, ack);
+  spdlog::info("ack sent: {} by {}", who, escape_text(a.operator_id));
+  // If the latched state is already past the sequence, the ack is stale: the sidecar refuses it,
+  // no need to wait.
+  const bool already_past = ack_already_past(req, row);
+  const auto confirm_by =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(already_past ? 0.0 : a.ack_timeout));
+  bool confirmed = false;
+  while (!confirmed && Clock::now() < confirm_by) {
+    view.poll(0.05);
+    confirmed = ack_confirmed(req, view.row(key));
+    if (wait_for_stop_signal(0.0) != 0) {
+      *stop = true;
+      return false;
     }
-    out->mmsi(static_cast<std::uint32_t>(mmsi));
-    out->sensor(static_cast<std::uint8_t>(sensor));
-    out->sequence(seq);
-  } catch (const std::exception&) {
-    *why = "--ack " + spec + ": MMSI (1..999999999) and SEQUENCE (>= 1) must be integers";
+  }
+  if (!confirmed) {
+    const Row* r = view.row(key);
+    const std::string reason = refusal_reason(req, r != nullptr ? r : row);
+    if (already_past) {
+      spdlog::error("ack {} not accepted: {} (the sidecar logs its refusal)", who, reason);
+    } else {
+      spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
+                    a.ack_timeout, reason);
+    }
     return false;
   }
+  const Row& now = *view.row(key);
+  spdlog::info("ack {} accepted: now #{} {}", who, now.ev.sequence, to_string(now.ev.state));
   return true;
 }
 
-/// Records the writers (sidecars) that went away: Fast DDS 2.9 neither delivers an
-/// instance-state sample when a writer disappears nor implements get_matched_publications(),
-/// so the monitor learns it from on_subscription_matched. Only copies a handle under a lock.
-class GoneWriters : public fdds::DataReaderListener {
- public:
-  void on_subscription_matched(fdds::DataReader*,
-                               const fdds::SubscriptionMatchedStatus& info) override {
-    std::lock_guard<std::mutex> lock(m_);
-    if (info.current_count_change < 0) {
-      gone_.push_back(info.last_publication_handle);
-    } else if (info.current_count_change > 0) {
-      back_.push_back(info.last_publication_handle);
-    }
-  }
-  /// Moves the handles of writers gone (and come back) since the last call into the outputs.
-  void take(std::vector<fdds::InstanceHandle_t>* gone, std::vector<fdds::InstanceHandle_t>* back) {
-    std::lock_guard<std::mutex> lock(m_);
-    gone->swap(gone_);
-    back->swap(back_);
-    gone_.clear();
-    back_.clear();
-  }
-
- private:
-  std::mutex m_;
-  std::vector<fdds::InstanceHandle_t> gone_, back_;
-};
-
-/// The FaultEvent and FdiStatus side of the monitor. The FdiStatus reader exists even without
-/// --status: the periodic status is what tells a quiet vessel from a silent one.
-class FleetView {
- public:
-  FleetView(dds::DdsContext& ctx, const MonitorArgs& a)
-      : ctx_(ctx), a_(a), filter_(a.mmsi.begin(), a.mmsi.end()), live_(a.silent_after) {
-    events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader,
-                                 &events_gone_, fdds::StatusMask::subscription_matched());
-    events_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
-    ws_.attach_condition(events_->get_statuscondition());
-    status_ = &ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader, &status_gone_,
-                                 fdds::StatusMask::subscription_matched());
-    status_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
-    ws_.attach_condition(status_->get_statuscondition());
-  }
-  ~FleetView() {
-    // The readers go before their listeners (a failure is logged by Fast DDS).
-    try {
-      if (status_ != nullptr) ctx_.delete_reader(*status_);
-      ctx_.delete_reader(*events_);
-    } catch (const std::exception& e) {
-      spdlog::warn("{}", e.what());
-    }
-  }
-  FleetView(const FleetView&) = delete;
-  FleetView& operator=(const FleetView&) = delete;
-
-  /// Waits up to `timeout` for data; applies what arrived, then flags the vessels that have
-  /// gone silent. Returns true if a row, a vessel status or a vessel's silence changed.
-  bool poll(double timeout) {
-    fdds::ConditionSeq active;
-    ws_.wait(active, eprosima::fastrtps::Duration_t(timeout));
-    bool changed = mark_gone_writers();
-    fdi::FaultEvent d;
-    fdds::SampleInfo info;
-    while (events_->take_next_sample(&d, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) {
-        // Disposed / no writers: keep the last known state, flagged.
-        const auto it = handles_.find(info.instance_handle);
-        if (it != handles_.end() && rows_.count(it->second)) {
-          Row& r = rows_[it->second];
-          if (r.alive) {
-            r.alive = false;
-            changed = true;
-            if (a_.json) emit_json(r);
-          }
-        }
-        continue;
-      }
-      if (!filter_.empty() && !filter_.count(d.mmsi())) continue;
-      changed |= heard(d.mmsi());
-      Row r;
-      r.mmsi = d.mmsi();
-      if (!service::from_dds(d, &r.ev)) {
-        spdlog::warn("ignored a FaultEvent from MMSI {} with unknown sensor/state/kind octets",
-                     d.mmsi());
-        continue;
-      }
-      r.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
-      r.writer = info.publication_handle;
-      const RowKey key{r.mmsi, static_cast<int>(r.ev.sensor)};
-      handles_[info.instance_handle] = key;
-      rows_[key] = r;
-      changed = true;
-      if (a_.json) emit_json(r);
-    }
-    {
-      fdi::FdiStatus s;
-      while (status_->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
-        if (!info.valid_data) {
-          const auto it = status_handles_.find(info.instance_handle);
-          if (it != status_handles_.end() && vessels_.count(it->second)) {
-            vessels_[it->second].alive = false;
-            changed = a_.status || changed;
-          }
-          continue;
-        }
-        if (!filter_.empty() && !filter_.count(s.mmsi())) continue;
-        changed |= heard(s.mmsi());
-        VesselStatus& v = vessels_[s.mmsi()];
-        v.st = s;
-        v.written = static_cast<double>(info.source_timestamp.to_ns()) * 1e-9;
-        v.writer = info.publication_handle;
-        v.alive = true;
-        status_handles_[info.instance_handle] = s.mmsi();
-        if (a_.json && a_.status) {
-          std::printf("%s\n", json_status(v, live_.age(s.mmsi(), mono_now())).c_str());
-          std::fflush(stdout);
-        }
-      }
-    }
-    for (const VesselLiveness::Change& c : live_.evaluate(mono_now())) {
-      emit_change(c);
-      changed = true;
-    }
-    return changed;
-  }
-
-  int matched_writers() const {
-    fdds::SubscriptionMatchedStatus st;
-    events_->get_subscription_matched_status(st);
-    return st.current_count;
-  }
-  const std::map<RowKey, Row>& rows() const { return rows_; }
-  const std::map<std::uint32_t, VesselStatus>* vessels() const {
-    return a_.status ? &vessels_ : nullptr;
-  }
-  const VesselLiveness& liveness() const { return live_; }
-  /// Seconds since anything was received from `mmsi` (NaN: never).
-  double heard_age(std::uint32_t mmsi) const { return live_.age(mmsi, mono_now()); }
-
- private:
-  /// Flags the rows (and vessel statuses) whose writer is gone. Returns true if one changed.
-  bool mark_gone_writers() {
-    bool changed = false;
-    std::vector<fdds::InstanceHandle_t> gone, back;
-    events_gone_.take(&gone, &back);
-    for (const auto& h : gone) {
-      for (auto& [key, r] : rows_) {
-        if (r.writer == h && r.alive) {
-          r.alive = false;
-          changed = true;
-          if (a_.json) emit_json(r);
-        }
-      }
-    }
-    status_gone_.take(&gone, &back);
-    for (const auto& h : gone) {
-      for (auto& [m, v] : vessels_) {
-        if (v.writer == h && v.alive) {
-          v.alive = false;
-          changed = a_.status || changed;
-        }
-      }
-    }
-    return changed;
-  }
-
-  /// Records a sample received from `mmsi` now; prints "heard again" if it was silent.
-  bool heard(std::uint32_t mmsi) {
-    VesselLiveness::Change c;
-    if (!live_.heard(mmsi, mono_now(), &c)) return false;
-    emit_change(c);
-    return true;
-  }
-
-  /// Prints a vessel's change of silence once (not with --once: it prints the final state).
-  void emit_change(const VesselLiveness::Change& c) const {
-    if (a_.once) return;
-    const std::string line =
-        a_.json ? json_change(c, live_.silent_after()) : change_line(c, live_.silent_after());
-    std::printf("%s\n", line.c_str());
-    std::fflush(stdout);
-  }
-
-  void emit_json(const Row& r) const {
-    if (a_.once) return;  // --once prints the final state only
-    std::printf("%s\n", json_row(r, live_.age(r.mmsi, mono_now())).c_str());
-    std::fflush(stdout);
-  }
-
-  dds::DdsContext& ctx_;
-  const MonitorArgs& a_;
-  std::set<std::uint32_t> filter_;
-  GoneWriters events_gone_, status_gone_;
-  fdds::DataReader* events_ = nullptr;
-  fdds::DataReader* status_ = nullptr;
-  fdds::WaitSet ws_;
-  std::map<RowKey, Row> rows_;
-  std::map<fdds::InstanceHandle_t, RowKey> handles_;
-  std::map<std::uint32_t, VesselStatus> vessels_;
-  std::map<fdds::InstanceHandle_t, std::uint32_t> status_handles_;
-  VesselLiveness live_;
-};
-
-/// Why the sidecar will refuse an ack, judged from the latched state the monitor sees.
-std::string refusal_reason(const fdi::FaultAck& ack, const Row* row) {
-  if (row == nullptr) return "no such fault instance is latched on this domain/partition";
-  const std::uint64_t cur = row->ev.sequence;
-  std::string state = " (current #" + std::to_string(cur) + ", " + to_string(row->ev.state) + ")";
-  if (ack.sequence() < cur) return "stale sequence" + state;
-  if (ack.sequence() > cur) return "unknown sequence" + state;
-  if (row->ev.state != FaultState::kRaised && row->ev.state != FaultState::kClearedUnacknowledged) {
-    return "nothing to acknowledge" + state;
-  }
-  return "no confirmation from the sidecar" + state;
-}
-
 int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
-              std::vector<fdi::FaultAck> acks) {
-  fdds::DataWriter& w = ctx.create_writer(dds::TopicId::kFaultAck, dds::profiles::kFaultAckWriter);
-  // Bounded wait until a sidecar's ack reader is matched (so the ack is not lost) and the
-  // latched state has arrived (so that the confirmation can be recognised).
-  const auto t_start = Clock::now();
-  const auto deadline = t_start + std::chrono::duration_cast<Clock::duration>(
-                                      std::chrono::duration<double>(a.discovery_timeout));
-  fdds::PublicationMatchedStatus st;
-  for (;;) {
-    w.get_publication_matched_status(st);
-    if (st.current_count > 0 || Clock::now() >= deadline) break;
-    view.poll(0.05);
-    if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
-  }
-  if (st.current_count == 0) {
-    spdlog::error("no sidecar subscribes to acknowledgements on domain {} (waited {:g} s)",
-                  ctx.config().domain_id, a.discovery_timeout);
-    return kExitFailure;
-  }
-  spdlog::debug("{} sidecar(s) matched after {:.3f} s", st.current_count,
-                std::chrono::duration<double>(Clock::now() - t_start).count());
-  // The reader side of the match completes asynchronously; give it, and the historical
-  // FaultEvents, a moment (bounded).
-  const auto settle = Clock::now() + std::chrono::milliseconds(300);
-  while (Clock::now() < settle) view.poll(0.05);
+              const std::vector<AckRequest>& acks) {
   int rc = kExitOk;
-  for (fdi::FaultAck& ack : acks) {
-    const RowKey key{ack.mmsi(), ack.sensor()};
-    const auto it = view.rows().find(key);
-    const Row* row = it == view.rows().end() ? nullptr : &it->second;
-    const std::string who = "MMSI " + std::to_string(ack.mmsi()) + " " +
-                            to_string(static_cast<Sensor>(ack.sensor())) + " #" +
-                            std::to_string(ack.sequence());
-    ack.stamp(wall_now());
-    if (row != nullptr) ack.incarnation(row->ev.incarnation);  // else refused by the sidecar
-    dds::write(w, ack);
-    spdlog::info("ack sent: {} by {}", who, a.operator_id);
-    // Confirmed when the instance moves from the acknowledged sequence past it, to an
-    // acknowledged state. If the latched state is already past it, the ack is stale: the
-    // sidecar refuses it, no need to wait.
-    const bool already_past = row != nullptr && row->ev.sequence > ack.sequence();
-    const auto confirm_by =
-        Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                           std::chrono::duration<double>(already_past ? 0.0 : a.ack_timeout));
-    bool confirmed = false;
-    while (!confirmed && Clock::now() < confirm_by) {
-      view.poll(0.05);
-      const auto r = view.rows().find(key);
-      confirmed = r != view.rows().end() && r->second.ev.sequence > ack.sequence() &&
-                  (r->second.ev.state == FaultState::kActiveAcknowledged ||
-                   r->second.ev.state == FaultState::kAcknowledged);
-      if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
-    }
-    if (!confirmed) {
-      const auto r = view.rows().find(key);
-      const std::string reason = refusal_reason(ack, r == view.rows().end() ? row : &r->second);
-      if (already_past) {
-        spdlog::error("ack {} not accepted: {} (the sidecar logs its refusal)", who, reason);
-      } else {
-        spdlog::error("ack {} not accepted within {:g} s: {} (the sidecar logs its reason)", who,
-                      a.ack_timeout, reason);
+  std::map<std::uint32_t, fdds::DataWriter*> writers;  // one per vessel, in its partition
+  for (const AckRequest& ack : acks) {
+    fdds::DataWriter*& w = writers[ack.mmsi];
+    if (w == nullptr) {
+      const auto parts = ack_partitions(ctx.config().publisher_partitions, ack.mmsi);
+      try {
+        w = &ctx.create_writer_in_partitions(dds::TopicId::kFaultAck,
+                                             dds::profiles::kFaultAckWriter, parts);
+      } catch (const std::exception& e) {
+        spdlog::error(
+            "cannot acknowledge vessel {}: {}{}", ack.mmsi, e.what(),
+            ctx.secure() ? " (under DDS Security: is this identity granted the vessel?)" : "");
+        rc = kExitFailure;
+        continue;
       }
-      rc = kExitFailure;
+      // Bounded wait until a sidecar's ack reader is matched (so the ack is not lost) and the
+      // latched state has arrived (so that the confirmation can be recognised).
+      const auto t_start = Clock::now();
+      const auto deadline = t_start + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(a.discovery_timeout));
+      fdds::PublicationMatchedStatus st;
+      for (;;) {
+        w->get_publication_matched_status(st);
+        if (st.current_count > 0 || Clock::now() >= deadline) break;
+        view.poll(0.05);
+        if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
+      }
+      if (st.current_count == 0) {
+        spdlog::error(
+            "no sidecar subscribes to acknowledgements of vessel {} on domain {} (waited {:g} s)",
+            ack.mmsi, ctx.config().domain_id, a.discovery_timeout);
+        rc = kExitFailure;
+        continue;
+      }
+      spdlog::debug("{} sidecar(s) matched after {:.3f} s", st.current_count,
+                    std::chrono::duration<double>(Clock::now() - t_start).count());
+      // The reader side of the match completes asynchronously; give it, and the historical
+      // FaultEvents, a moment (bounded).
+      const auto settle = Clock::now() + std::chrono::milliseconds(300);
+      while (Clock::now() < settle) view.poll(0.05);
+      // On a busy machine the latched state may take longer: the ack must name the current
+      // event's incarnation, so wait (bounded) until some instance of the vessel has arrived.
+      while (!has_vessel(view, ack.mmsi) && Clock::now() < deadline) {
+        view.poll(0.05);
+        if (wait_for_stop_signal(0.0) != 0) return kExitFailure;
+      }
+    }
+    fdds::PublicationMatchedStatus st;
+    w->get_publication_matched_status(st);
+    if (st.current_count == 0) {
+      rc = kExitFailure;  // reported above
       continue;
     }
-    const Row& now = view.rows().at(key);
-    spdlog::info("ack {} accepted: now #{} {}", who, now.ev.sequence, to_string(now.ev.state));
+    bool stop = false;
+    if (!send_ack(*w, view, a, ack, &stop)) rc = kExitFailure;
+    if (stop) return kExitFailure;
   }
   return rc;
 }
@@ -540,15 +157,14 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
 int run_monitor(const MonitorArgs& a) {
   block_stop_signals();  // before Fast DDS starts its threads
   route_fastdds_log_to_spdlog();
-  std::vector<fdi::FaultAck> acks;
+  std::vector<AckRequest> acks;
   for (const std::string& spec : a.acks) {
-    fdi::FaultAck ack;
+    AckRequest ack;
     std::string why;
     if (!parse_ack(spec, &ack, &why)) {
       spdlog::error("{}", why);
       return kExitUsage;
     }
-    ack.operator_id(a.operator_id.substr(0, 63).c_str());
     acks.push_back(ack);
   }
   dds::DdsConfig cfg;
@@ -567,6 +183,18 @@ int run_monitor(const MonitorArgs& a) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
+  CredentialExpiry expiry;
+  try {
+    expiry = credential_expiry(cfg.participant_profile);
+  } catch (const std::exception& e) {
+    spdlog::error("DDS Security: {}", e.what());
+    return kExitConfig;
+  }
+  if (expiry.secure()) spdlog::info("{}", validity_message(expiry));
+  if (expiry.expired(wall_now())) {
+    spdlog::error("{}", expired_message(expiry));
+    return kExitFailure;
+  }
   const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
   if (!a.acks.empty()) {
     const int rc = send_acks(*ctx, *view, a, acks);
@@ -578,8 +206,12 @@ int run_monitor(const MonitorArgs& a) {
   for (;;) {
     const bool changed = view->poll(0.2);
     if (changed && !a.json && !a.once) {
-      print_table(view->rows(), view->vessels(), view->liveness());
+      print_table(*view);
       printed = true;
+    }
+    if (expiry.expired(wall_now())) {  // Fast DDS would keep the session open
+      spdlog::error("{}", expired_message(expiry));
+      return kExitFailure;
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     const bool enough = a.expect > 0 && static_cast<int>(view->rows().size()) >= a.expect;
@@ -587,20 +219,20 @@ int run_monitor(const MonitorArgs& a) {
   }
   if (a.once) {
     if (a.json) {
-      for (const auto& [key, r] : view->rows()) {
-        std::printf("%s\n", json_row(r, view->heard_age(r.mmsi)).c_str());
-      }
+      view->rows().for_each([&](const RowKey&, const Row& r) {
+        std::printf("%s\n", json_row(r, view->heard_age(r.mmsi), wall_now()).c_str());
+      });
       if (view->vessels() != nullptr) {
-        for (const auto& [m, v] : *view->vessels()) {
-          std::printf("%s\n", json_status(v, view->heard_age(m)).c_str());
-        }
+        view->vessels()->for_each([&](const std::uint32_t& m, const VesselStatus& v) {
+          std::printf("%s\n", json_status(v, view->heard_age(m), wall_now()).c_str());
+        });
       }
       std::fflush(stdout);
     } else {
-      print_table(view->rows(), view->vessels(), view->liveness());
+      print_table(*view);
     }
   } else if (!a.json && !printed) {
-    print_table(view->rows(), view->vessels(), view->liveness());
+    print_table(*view);
   }
   if (a.expect > 0 && static_cast<int>(view->rows().size()) < a.expect) {
     spdlog::error("saw {} fault instances, expected {}", view->rows().size(), a.expect);

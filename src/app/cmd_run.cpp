@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "commands.hpp"
+#include "credentials.hpp"
 #include "dds_options.hpp"
 #include "usv_fdi/dds_service/health.hpp"
 #include "usv_fdi/dds_service/service.hpp"
@@ -202,6 +203,15 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
     health.write("failed", std::string("cannot start the DDS service: ") + e.what());
     return kExitFailure;
   }
+  CredentialExpiry expiry;  // Fast DDS checks it at the handshake only: watched here
+  try {
+    expiry = credential_expiry(cfg.dds.participant_profile);
+  } catch (const std::exception& e) {
+    spdlog::error("DDS Security: {}", e.what());
+    health.write("failed", std::string("DDS Security: ") + e.what());
+    return kExitConfig;
+  }
+  if (expiry.secure()) spdlog::info("{}", validity_message(expiry));
   svc->start();
   health.write("running", "", svc.get());
   spdlog::info(
@@ -216,6 +226,14 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   auto last_health = std::chrono::steady_clock::now();
   while ((sig = wait_for_stop_signal(std::min(0.5, period))) == 0) {
     const auto now = std::chrono::steady_clock::now();
+    if (expiry.expired(
+            std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+                .count())) {
+      spdlog::error("{}", expired_message(expiry));
+      health.write("failed", expired_message(expiry));
+      svc->stop();
+      return kExitFailure;
+    }
     if (std::chrono::duration<double>(now - last_health).count() >= period) {
       last_health = now;
       health.write("running", "", svc.get());

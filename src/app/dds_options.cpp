@@ -8,6 +8,7 @@
 #include <ctime>
 #include <memory>
 
+#include "usv_fdi/core/text.hpp"
 #include "usv_fdi/dds_service/service.hpp"
 
 namespace usvfdi::app {
@@ -74,16 +75,19 @@ class SpdlogConsumer : public eprosima::fastdds::dds::LogConsumer {
  public:
   void Consume(const eprosima::fastdds::dds::Log::Entry& e) override {
     using Kind = eprosima::fastdds::dds::Log::Kind;
-    const char* category = e.context.category != nullptr ? e.context.category : "?";
+    // Fast DDS's messages may quote what a peer sent (partition, topic, type names): escaped.
+    const std::string category =
+        escape_text(e.context.category != nullptr ? e.context.category : "?");
+    const std::string message = escape_text(e.message);
     switch (e.kind) {
       case Kind::Error:
-        spdlog::error("Fast DDS [{}] {}", category, e.message);
+        spdlog::error("Fast DDS [{}] {}", category, message);
         break;
       case Kind::Warning:
-        spdlog::warn("Fast DDS [{}] {}", category, e.message);
+        spdlog::warn("Fast DDS [{}] {}", category, message);
         break;
       default:
-        spdlog::debug("Fast DDS [{}] {}", category, e.message);
+        spdlog::debug("Fast DDS [{}] {}", category, message);
         break;
     }
   }

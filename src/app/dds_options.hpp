@@ -1,4 +1,5 @@
-// Command-line options shared by the DDS subcommands (run, monitor, sim --publish).
+// Command-line options shared by the DDS subcommands (run, monitor, sim --publish). No Fast DDS
+// in this header: DdsConfig is only declared (include usv_fdi/dds/dds_context.hpp to use it).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -8,7 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "usv_fdi/dds/dds_context.hpp"
+namespace usv_fdi::dds {
+struct DdsConfig;
+}  // namespace usv_fdi::dds
 
 namespace usvfdi::app {
 

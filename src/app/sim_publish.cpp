@@ -74,15 +74,45 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
                opt.reliable ? "RELIABLE" : "BEST_EFFORT");
   auto t0 = Clock::now();
   std::uint64_t seq = 0, failed = 0;
+  // A deterministic stream, not a race with the wall clock: with RELIABLE writers the voyage
+  // waits for the readers' acknowledgements every kAckEvery samples (half the writers' 256-deep
+  // history), so no sample is ever overwritten before a slow reader has it; and when the process
+  // falls behind its schedule (a starved machine) it shifts the schedule instead of bursting to
+  // catch up. Both are counted and reported at the end.
+  constexpr std::uint64_t kAckEvery = 128;
+  const auto kLate = std::chrono::milliseconds(250);
+  int behind = 0;             // times the schedule was shifted
+  double behind_s = 0.0;      // by how much in all [s of wall time]
+  int ack_waits_failed = 0;   // flow-control waits that timed out
+  double ack_wait_max = 0.0;  // the longest flow-control wait [s]
   std::vector<SimRow> rows(sims.size());
   bool stopped = false;
   for (bool more = true; more && !stopped;) {
     for (std::size_t i = 0; i < sims.size() && more; ++i) more = sims[i]->next(&rows[i]);
     if (!more) break;
     const double t = rows.front().t;
-    std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(t / opt.speed)));
+    const auto due = t0 + std::chrono::duration_cast<Clock::duration>(
+                              std::chrono::duration<double>(t / opt.speed));
+    const auto now = Clock::now();
+    if (now > due + kLate) {
+      t0 += now - due;
+      ++behind;
+      behind_s += std::chrono::duration<double>(now - due).count();
+    } else {
+      std::this_thread::sleep_until(due);
+    }
     ++seq;
+    if (opt.reliable && seq > 1 && seq % kAckEvery == 0) {
+      const auto w0 = Clock::now();
+      const eprosima::fastrtps::Duration_t bound(10.0);
+      const bool ok = ins->wait_for_acknowledgments(bound) ==
+                          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK &&
+                      rud->wait_for_acknowledgments(bound) ==
+                          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+      if (!ok) ++ack_waits_failed;
+      ack_wait_max =
+          std::max(ack_wait_max, std::chrono::duration<double>(Clock::now() - w0).count());
+    }
     // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp and
     // releases it as soon as a rudder sample at or after that stamp has arrived.
     for (std::size_t i = 0; i < sims.size(); ++i) {
@@ -135,6 +165,12 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
   }
   spdlog::info("published {} samples per vessel{}{}", seq, stopped ? " (stopped by a signal)" : "",
                failed ? ", " + std::to_string(failed) + " writes failed" : std::string());
+  // Whether the machine kept up: a test that fails can say if it was starved.
+  spdlog::info(
+      "pacing: fell behind the schedule {} time(s), {:.2f} s in all (shifted, not caught up); "
+      "longest wait for the readers' acknowledgements {:.3f} s, {} wait(s) timed out{}",
+      behind, behind_s, ack_wait_max, ack_waits_failed,
+      behind > 0 || ack_waits_failed > 0 ? " (a busy machine)" : "");
   if (!stopped) {
     // Reliable writers: let the readers acknowledge the tail; then linger (bounded).
     const eprosima::fastrtps::Duration_t linger(opt.linger);

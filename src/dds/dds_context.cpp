@@ -109,8 +109,11 @@ DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
   }
 
   auto* factory = fdds::DomainParticipantFactory::get_instance();
+  peers_ = std::make_unique<PeerDirectory>();
+  // Discovery callbacks only (StatusMask::none(): no entity status reaches this listener).
   participant_.reset(factory->create_participant_with_profile(
-      static_cast<fdds::DomainId_t>(config_.domain_id), config_.participant_profile));
+      static_cast<fdds::DomainId_t>(config_.domain_id), config_.participant_profile, peers_.get(),
+      fdds::StatusMask::none()));
   if (!participant_) {
     fail("creating participant on domain " + std::to_string(config_.domain_id) + " from profile '" +
          config_.participant_profile + "' failed");
@@ -146,6 +149,13 @@ DdsContext::~DdsContext() = default;
 
 fdds::Topic& DdsContext::topic(TopicId id) const { return *topics_[index_of(id)]; }
 
+bool DdsContext::secure() const {
+  for (const auto& p : participant_->get_qos().properties().properties()) {
+    if (p.name() == "dds.sec.auth.plugin" && !p.value().empty()) return true;
+  }
+  return false;
+}
+
 fdds::DataWriter& DdsContext::create_writer(TopicId id, const std::string& profile,
                                             fdds::DataWriterListener* listener,
                                             const fdds::StatusMask& mask) {
@@ -154,6 +164,23 @@ fdds::DataWriter& DdsContext::create_writer(TopicId id, const std::string& profi
   if (writer == nullptr) {
     fail("creating data writer on topic '" + t->get_name() + "' from profile '" + profile +
          "' failed");
+  }
+  return *writer;
+}
+
+fdds::DataWriter& DdsContext::create_writer_in_partitions(
+    TopicId id, const std::string& profile, const std::vector<std::string>& partitions) {
+  fdds::PublisherQos qos = participant_->get_default_publisher_qos();
+  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
+  fdds::Publisher* pub = participant_->create_publisher(qos);  // deleted with the participant
+  if (pub == nullptr) fail("creating a publisher for topic '" + topic(id).get_name() + "' failed");
+  fdds::Topic* t = topics_[index_of(id)];
+  fdds::DataWriter* writer = pub->create_datawriter_with_profile(t, profile);
+  if (writer == nullptr) {
+    std::string in;
+    for (const auto& p : partitions) in += (in.empty() ? "" : ", ") + p;
+    fail("creating data writer on topic '" + t->get_name() + "' from profile '" + profile +
+         "' in partition(s) " + (in.empty() ? std::string("<default>") : in) + " failed");
   }
   return *writer;
 }

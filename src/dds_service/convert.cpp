@@ -1,5 +1,7 @@
 #include "usv_fdi/dds_service/convert.hpp"
 
+#include "usv_fdi/core/text.hpp"
+
 #include <string>
 
 namespace usvfdi::service {
@@ -63,7 +65,7 @@ bool from_dds(const fdi::FaultEvent& d, FaultEvent* out) {
   e.sequence = d.sequence();
   e.incarnation = d.incarnation();
   e.A << d.a()[0], d.a()[1], d.a()[2], d.a()[3];
-  e.message = d.message().to_string();
+  e.message = escape_text(d.message().to_string());  // a peer's text: never raw
   *out = e;
   return true;
 }
@@ -132,7 +134,7 @@ AckInput from_dds(const fdi::FaultAck& a) {
   AckInput out;
   out.sensor = static_cast<Sensor>(a.sensor());
   out.sequence = a.sequence();
-  out.who = a.operator_id().to_string();
+  out.who = escape_text(a.operator_id().to_string());  // a peer's text: never raw
   out.incarnation = a.incarnation();
   return out;
 }

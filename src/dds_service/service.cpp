@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "usv_fdi/core/text.hpp"
 #include "usv_fdi/dds_service/convert.hpp"
 
 namespace usvfdi::service {
@@ -35,17 +36,30 @@ using eprosima::fastrtps::types::ReturnCode_t;
 /// once (one per transport), so it keeps no state but atomics.
 class FdiService::Listener : public DataReaderListener {
  public:
-  Listener(FdiPipeline* p, std::uint32_t mmsi) : p_(p), mmsi_(mmsi) {}
+  /// `peers`: the participant's directory when it runs DDS Security (nullptr: it does not).
+  Listener(FdiPipeline* p, std::uint32_t mmsi, const dds::PeerDirectory* peers)
+      : p_(p), mmsi_(mmsi), peers_(peers) {}
   void on_data_available(DataReader* reader) override {
+    using Info = eprosima::fastdds::dds::SampleInfo;
     if (reader == ins_) {
-      drain<fdi::InsSample>(*reader,
-                            [this](const fdi::InsSample& s) { return p_->push_ins(from_dds(s)); });
+      drain<fdi::InsSample>(*reader, [this](const fdi::InsSample& s, const Info&) {
+        return p_->push_ins(from_dds(s));
+      });
     } else if (reader == rudder_) {
-      drain<fdi::RudderSample>(
-          *reader, [this](const fdi::RudderSample& s) { return p_->push_rudder(from_dds(s)); });
+      drain<fdi::RudderSample>(*reader, [this](const fdi::RudderSample& s, const Info&) {
+        return p_->push_rudder(from_dds(s));
+      });
     } else if (reader == ack_) {
-      drain<fdi::FaultAck>(*reader,
-                           [this](const fdi::FaultAck& a) { return p_->push_ack(from_dds(a)); });
+      drain<fdi::FaultAck>(*reader, [this](const fdi::FaultAck& a, const Info& info) {
+        AckInput in = from_dds(a);
+        // Under DDS Security the operator is the writer's authenticated identity, not what the
+        // sample claims.
+        if (peers_ != nullptr) {
+          in.who = escape_text(dds::operator_of(peers_->subject_of(info.publication_handle),
+                                                a.operator_id().to_string()));
+        }
+        return p_->push_ack(in);
+      });
     }
   }
   DataReader* ins_ = nullptr;
@@ -65,12 +79,13 @@ class FdiService::Listener : public DataReaderListener {
         foreign.fetch_add(1, std::memory_order_relaxed);
         continue;
       }
-      push(sample);  // a full queue drops its oldest element and counts it
+      push(sample, info);  // a full queue drops its oldest element and counts it
     }
   }
 
   FdiPipeline* p_;
   std::uint32_t mmsi_;
+  const dds::PeerDirectory* peers_;
 };
 
 /// Watches the FaultEvent topic for this vessel's instances written by anyone but this
@@ -202,7 +217,8 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   }
   pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, popt, on_event, on_status, log_);
   for (const FaultEvent& e : restored_) pipeline_->restore(e);
-  listener_ = std::make_unique<Listener>(pipeline_.get(), mmsi);
+  listener_ =
+      std::make_unique<Listener>(pipeline_.get(), mmsi, dds_->secure() ? &dds_->peers() : nullptr);
   DataReader& ins = dds_->create_reader(dds::TopicId::kIns,
                                         cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
                                                              : dds::profiles::kInsReaderBestEffort);

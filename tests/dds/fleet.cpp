@@ -33,60 +33,11 @@ std::string slurp(const std::string& path) {
 bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,
                         std::vector<MonitorStatus>* statuses, std::string* error,
                         std::vector<MonitorVessel>* vessels) {
-  if (line.empty() || line[0] != '{') return true;
   try {
-    const js::Value v = js::Parser(line).parse_document();
-    const std::string type = v.at("type").str;
-    if (type == "fault") {
-      MonitorEvent e;
-      e.mmsi = static_cast<unsigned>(v.at("mmsi").num);
-      e.sensor = v.at("sensor").str;
-      e.state = v.at("state").str;
-      e.kind = v.at("kind").str;
-      e.c_a = v.at("c_a").num;
-      e.c_g = v.at("c_g").num;
-      e.onset_time = v.at("onset_time").num;
-      e.detection_time = v.at("detection_time").num;
-      e.stamp = v.at("stamp").num;
-      e.sequence = static_cast<unsigned long long>(v.at("sequence").num);
-      e.alive = v.at("alive").b;
-      e.heard_age_s = v.at("heard_age_s").num;
-      if (events != nullptr) events->push_back(e);
-    } else if (type == "status") {
-      MonitorStatus s;
-      s.mmsi = static_cast<unsigned>(v.at("mmsi").num);
-      s.stamp = v.at("stamp").kind == js::Value::kNumber ? v.at("stamp").num : -1.0;
-      s.converged = v.at("converged").b;
-      s.armed = v.at("armed").b;
-      s.samples = static_cast<unsigned long long>(v.at("samples").num);
-      s.dropped = static_cast<unsigned long long>(v.at("dropped").num);
-      const auto names = [&](const char* key) {
-        std::vector<std::string> out;
-        for (const js::Value& x : v.at(key).arr) out.push_back(x.str);
-        return out;
-      };
-      s.input_flags = names("input_flags");
-      s.identification_paused = names("identification_paused");
-      s.isolation_paused = names("isolation_paused");
-      const auto count = [&](const char* key) {
-        return static_cast<unsigned long long>(v.at(key).num);
-      };
-      s.rejected_timestamps = count("rejected_timestamps");
-      s.invalid_values = count("invalid_values");
-      s.gaps = count("gaps");
-      s.reordered = count("reordered");
-      s.dropped_inputs = count("dropped_inputs");
-      s.heard_age_s = v.at("heard_age_s").num;
-      if (statuses != nullptr) statuses->push_back(s);
-    } else if (type == "vessel") {
-      MonitorVessel m;
-      m.mmsi = static_cast<unsigned>(v.at("mmsi").num);
-      m.silent = v.at("silent").b;
-      m.heard_age_s = v.at("heard_age_s").num;
-      if (!m.silent) m.gap_s = v.at("gap_s").num;
-      m.silent_after_s = v.at("silent_after_s").num;
-      if (vessels != nullptr) vessels->push_back(m);
-    }
+    const test_support::MonitorLine l = test_support::parse_monitor_json(line);
+    if (l.type == "fault" && events != nullptr) events->push_back(l.fault);
+    if (l.type == "status" && statuses != nullptr) statuses->push_back(l.status);
+    if (l.type == "vessel" && vessels != nullptr) vessels->push_back(l.vessel);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
@@ -101,12 +52,6 @@ std::vector<std::string> sim_args(const std::vector<std::string>& extra) {
   a.insert(a.end(), extra.begin(), extra.end());
   return a;
 }
-
-bool MonitorStatus::has(const std::vector<std::string>& v, const std::string& f) {
-  return std::find(v.begin(), v.end(), f) != v.end();
-}
-
-bool MonitorStatus::has_flag(const std::string& f) const { return has(input_flags, f); }
 
 Fleet::Fleet() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

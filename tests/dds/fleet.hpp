@@ -10,40 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "monitor_json.hpp"
 #include "process.hpp"
 
 namespace usv_fdi::dds::test {
 
-/// One FaultEvent update as printed by `usv-fdi monitor --json`.
-struct MonitorEvent {
-  unsigned mmsi = 0;
-  std::string sensor, state, kind;
-  double c_a = 0, c_g = 0, onset_time = 0, detection_time = 0, stamp = 0;
-  unsigned long long sequence = 0;
-  bool alive = true;
-  double heard_age_s = -1;  ///< seconds since the monitor last received anything from the vessel
-};
-
-/// One FdiStatus as printed by `usv-fdi monitor --json --status`.
-struct MonitorStatus {
-  unsigned mmsi = 0;
-  double stamp = 0;
-  bool converged = false, armed = false;
-  unsigned long long samples = 0, dropped = 0;
-  std::vector<std::string> input_flags, identification_paused, isolation_paused;
-  unsigned long long rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
-                     dropped_inputs = 0;
-  double heard_age_s = -1;
-  bool has_flag(const std::string& f) const;
-  static bool has(const std::vector<std::string>& v, const std::string& f);
-};
-
-/// A change of a vessel's silence as printed by `usv-fdi monitor --json` ("type":"vessel").
-struct MonitorVessel {
-  unsigned mmsi = 0;
-  bool silent = false;
-  double heard_age_s = -1, gap_s = -1, silent_after_s = -1;
-};
+/// The monitor's JSON Lines, as the one model of the test-support library (monitor_json.hpp).
+using MonitorEvent = usv_fdi::test_support::MonitorFault;
+using MonitorStatus = usv_fdi::test_support::MonitorStatusLine;
+using MonitorVessel = usv_fdi::test_support::MonitorVesselChange;
 
 /// Parses monitor --json lines (others are ignored); returns false on a malformed JSON line.
 bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,

@@ -2,9 +2,10 @@
 //
 //   usv_fdi_dds_probe publish-faults --profiles FILE [--domain N] [--participant-profile P]
 //       [--partition NAME] [--vessels M] [--sensors S] [--state X] [--rewrite-state Y]
-//       [--mmsi-base B] [--timeout SECONDS]
-//     Writes one FaultEvent per (vessel, sensor) with the given state (sequence 1); with
-//     --rewrite-state also rewrites instance (mmsi-base, sensor 0) with state Y (sequence 2).
+//       [--mmsi-base B] [--sequence Q] [--sensor K] [--message TEXT] [--timeout SECONDS]
+//     Writes one FaultEvent per (vessel, sensor) with the given state and sequence (default 1;
+//     --sensor K: sensor K only); with --rewrite-state also rewrites instance (mmsi-base, sensor 0)
+//     with state Y (sequence Q+1). A forger, when another participant owns the instances.
 //     Prints "published instances=I writes=W" and stays alive until SIGTERM/SIGINT (exit 0) or
 //     the timeout (exit 2).
 //
@@ -73,6 +74,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include "probe_common.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 
 namespace {
@@ -82,11 +84,11 @@ using usv_fdi::dds::DdsConfig;
 using usv_fdi::dds::DdsContext;
 namespace profiles = usv_fdi::dds::profiles;
 using Clock = std::chrono::steady_clock;
-
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "signal flag must be lock free");
-
-extern "C" void on_signal(int) { g_stop.store(true); }  // no I/O, async-signal-safe
+using usv_fdi::test_support::probe::deadline_after;
+using usv_fdi::test_support::probe::g_stop;
+using usv_fdi::test_support::probe::install_signal_handlers;
+using usv_fdi::test_support::probe::parse_unsigned;
+using usv_fdi::test_support::probe::UsageError;
 
 struct Options {
   std::string mode;
@@ -95,6 +97,9 @@ struct Options {
   unsigned sensors = 2;
   unsigned state = 1;
   std::optional<unsigned> rewrite_state;
+  std::uint64_t sequence = 1;
+  std::optional<unsigned> sensor;
+  std::optional<std::string> message;
   std::uint32_t mmsi_base = 257000000;
   double timeout_s = 30.0;
   unsigned expect = 0;
@@ -104,21 +109,6 @@ struct Options {
   std::string script;
   unsigned delay_ms = 200;
 };
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-unsigned long parse_unsigned(const std::string& flag, const std::string& value) {
-  try {
-    std::size_t used = 0;
-    const unsigned long v = std::stoul(value, &used);
-    if (used != value.size()) throw std::invalid_argument(value);
-    return v;
-  } catch (const std::exception&) {
-    throw UsageError(flag + ": not an unsigned integer: '" + value + "'");
-  }
-}
 
 Options parse(int argc, char** argv) {
   if (argc < 2) {
@@ -151,6 +141,12 @@ Options parse(int argc, char** argv) {
       if (o.sensors < 1 || o.sensors > 3) throw UsageError("--sensors must be 1..3");
     } else if (flag == "--state") {
       o.state = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--sequence") {
+      o.sequence = parse_unsigned(flag, value);
+    } else if (flag == "--sensor") {
+      o.sensor = static_cast<unsigned>(parse_unsigned(flag, value));
+    } else if (flag == "--message") {
+      o.message = value;
     } else if (flag == "--rewrite-state") {
       o.rewrite_state = static_cast<unsigned>(parse_unsigned(flag, value));
     } else if (flag == "--mmsi-base") {
@@ -182,20 +178,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-Clock::time_point deadline_after(double seconds) {
-  return Clock::now() +
-         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-}
-
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGINT, &sa, nullptr);
-}
-
 fdi::FaultEvent make_event(std::uint32_t mmsi, unsigned sensor, unsigned state,
                            std::uint64_t sequence) {
   fdi::FaultEvent e;
@@ -222,17 +204,22 @@ int publish_faults(const Options& o) {
   DdsContext ctx(o.dds);
   fdds::DataWriter& writer = ctx.create_writer<fdi::FaultEvent>(profiles::kFaultEventWriter);
   unsigned writes = 0;
+  unsigned instances = 0;
   for (unsigned v = 0; v < o.vessels; ++v) {
     for (unsigned s = 0; s < o.sensors; ++s) {
-      usv_fdi::dds::write(writer, make_event(o.mmsi_base + v, s, o.state, 1));
+      if (o.sensor && s != *o.sensor) continue;
+      fdi::FaultEvent e = make_event(o.mmsi_base + v, s, o.state, o.sequence);
+      if (o.message) e.message(*o.message);
+      usv_fdi::dds::write(writer, e);
       ++writes;
+      ++instances;
     }
   }
   if (o.rewrite_state) {
-    usv_fdi::dds::write(writer, make_event(o.mmsi_base, 0, *o.rewrite_state, 2));
+    usv_fdi::dds::write(writer, make_event(o.mmsi_base, 0, *o.rewrite_state, o.sequence + 1));
     ++writes;
   }
-  std::printf("published instances=%u writes=%u\n", o.vessels * o.sensors, writes);
+  std::printf("published instances=%u writes=%u\n", instances, writes);
   std::fflush(stdout);
   while (!g_stop.load() && Clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

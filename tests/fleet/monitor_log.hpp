@@ -9,45 +9,23 @@
 #include <string>
 #include <vector>
 
-#include "io/json_lite.hpp"
+#include "monitor_json.hpp"
 #include "process.hpp"
 
 namespace usv_fdi::fleet::test {
 
-/// One FaultEvent update as printed by the monitor.
-struct FaultUpdate {
-  unsigned mmsi = 0;
-  std::string sensor, state, kind, message;
-  double c_a = 0, c_g = 0, statistic = 0, threshold = 0, onset_time = 0, detection_time = 0;
-  double stamp = 0;  ///< time of this state change (vessel's source clock) [s]
-  double age_s = 0;  ///< wall seconds since the sidecar wrote it, when the monitor printed it
-  unsigned long long sequence = 0;
-  bool alive = true;      ///< false: the monitor has lost the sidecar that wrote it
-  double received = 0.0;  ///< when the test read the line [s on the test's clock]
-};
-
-/// One FdiStatus update as printed by the monitor (--status).
-struct StatusUpdate {
-  unsigned mmsi = 0;
-  double stamp = -1;  ///< -1: no sample yet
-  bool converged = false, armed = false, ins_healthy = false, rudder_healthy = false;
-  unsigned long long samples = 0, dropped = 0;
-  double received = 0.0;
-};
-
-/// A vessel going silent (nothing received for --silent-after) or heard again.
-struct VesselChange {
-  unsigned mmsi = 0;
-  bool silent = false;
-  double heard_age_s = 0.0;
-  double received = 0.0;
-};
+/// The monitor's JSON Lines, as the one model of the test-support library (monitor_json.hpp).
+using FaultUpdate = usv_fdi::test_support::MonitorFault;
+using StatusUpdate = usv_fdi::test_support::MonitorStatusLine;
+using VesselChange = usv_fdi::test_support::MonitorVesselChange;
+using ConflictReport = usv_fdi::test_support::MonitorConflict;
 
 /// Everything a monitor printed, in order.
 struct MonitorLog {
   std::vector<FaultUpdate> faults;
   std::vector<StatusUpdate> statuses;
   std::vector<VesselChange> vessels;
+  std::vector<ConflictReport> conflicts;
   std::vector<std::string> other;  ///< lines that are not JSON objects (there should be none)
 
   /// Parses one stdout line; throws std::runtime_error on a malformed JSON line.
@@ -56,47 +34,16 @@ struct MonitorLog {
       if (!line.empty()) other.push_back(line);
       return;
     }
-    namespace js = usvfdi::testing_json;
-    const js::Value v = js::Parser(line).parse_document();
-    const std::string type = v.at("type").str;
-    if (type == "fault") {
-      FaultUpdate f;
-      f.mmsi = static_cast<unsigned>(v.at("mmsi").num);
-      f.sensor = v.at("sensor").str;
-      f.state = v.at("state").str;
-      f.kind = v.at("kind").str;
-      f.message = v.at("message").str;
-      f.c_a = v.at("c_a").num;
-      f.c_g = v.at("c_g").num;
-      f.statistic = v.at("statistic").num;
-      f.threshold = v.at("threshold").num;
-      f.onset_time = v.at("onset_time").num;
-      f.detection_time = v.at("detection_time").num;
-      f.stamp = v.at("stamp").num;
-      f.age_s = v.at("age_s").num;
-      f.sequence = static_cast<unsigned long long>(v.at("sequence").num);
-      f.alive = v.at("alive").b;
-      f.received = received;
-      faults.push_back(f);
-    } else if (type == "status") {
-      StatusUpdate s;
-      s.mmsi = static_cast<unsigned>(v.at("mmsi").num);
-      s.stamp = v.at("stamp").kind == js::Value::kNumber ? v.at("stamp").num : -1.0;
-      s.converged = v.at("converged").b;
-      s.armed = v.at("armed").b;
-      s.ins_healthy = v.at("ins_healthy").b;
-      s.rudder_healthy = v.at("rudder_healthy").b;
-      s.samples = static_cast<unsigned long long>(v.at("samples").num);
-      s.dropped = static_cast<unsigned long long>(v.at("dropped").num);
-      s.received = received;
-      statuses.push_back(s);
-    } else if (type == "vessel") {
-      VesselChange c;
-      c.mmsi = static_cast<unsigned>(v.at("mmsi").num);
-      c.silent = v.at("silent").b;
-      c.heard_age_s = v.at("heard_age_s").num;
-      c.received = received;
-      vessels.push_back(c);
+    const usv_fdi::test_support::MonitorLine l =
+        usv_fdi::test_support::parse_monitor_json(line, received);
+    if (l.type == "fault") {
+      faults.push_back(l.fault);
+    } else if (l.type == "status") {
+      statuses.push_back(l.status);
+    } else if (l.type == "vessel") {
+      vessels.push_back(l.vessel);
+    } else if (l.type == "conflict") {
+      conflicts.push_back(l.conflict);
     } else {
       other.push_back(line);
     }

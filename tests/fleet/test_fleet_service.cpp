@@ -269,7 +269,10 @@ std::string run_fleet(ServiceFleet& f, const char* discovery) {
   int attempts = 0;
   std::optional<int> ack;
   std::string ack_log;
-  const std::string accepted = "ack of accelerometer #2 by shore-op accepted";
+  // Under DDS Security the operator id is the shore identity's CN with the claimed id appended.
+  const bool secure = std::string(discovery).rfind("secure", 0) == 0;
+  const std::string accepted = std::string("ack of accelerometer #2 by ") +
+                               (secure ? "shore:shore-op" : "shore-op") + " accepted";
   while (attempts < 3) {
     const std::string name = "ack" + std::to_string(++attempts);
     ack = f.run_on_shore(name,
@@ -355,11 +358,13 @@ TEST(FleetService, SecureFleetWithUnicastDiscovery) {
     }
   } remove_pki{o.secure_pki};
   std::vector<std::string> argv = {kSource + "/scripts/make-security.sh", o.secure_pki, "--force",
-                                   "--identity", "shore:shore"};
+                                   "--identity", "shore:shore:*"};
   std::string peers = "10.77.0.5";
   for (unsigned i = 1; i <= o.vessels; ++i) {
     const std::string v = "vessel" + std::to_string(i);
-    argv.insert(argv.end(), {"--identity", "vessel:" + v, "--identity", "sensors:" + v + "-sim"});
+    const std::string m = std::to_string(257000000 + i);  // each identity bound to its vessel
+    argv.insert(argv.end(), {"--identity", "vessel:" + v + ":" + m, "--identity",
+                             "sensors:" + v + "-sim:" + m});
     peers += ",10.77.0." + std::to_string(10 + i);
   }
   argv.insert(argv.end(), {"--initial-peers", peers});

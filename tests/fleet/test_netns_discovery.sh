@@ -10,31 +10,10 @@ set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 probe="$1"
 qos="$2"
-# shellcheck source=netns.sh
-source "$here/netns.sh"
-
-if ! reason="$(fleet_netns_check)"; then
-  echo "SKIP: $reason"
-  exit 77
-fi
-command -v fastdds >/dev/null || { echo "FAIL: fastdds not found (fastdds-tools)"; exit 1; }
-
-name="ds$(( $$ % 100000 ))"
-work="$(mktemp -d)"
-cleanup() {
-  fleet_netns_down "$name"
-  rm -rf "$work"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do
-    [ -f "$f" ] && { echo "--- $(basename "$f")"; tail -n 30 "$f"; }
-  done
-  exit 1
-}
+# shellcheck source=netns_preamble.sh
+source "$here/netns_preamble.sh"
+netns_test_begin ds 30
+command -v fastdds >/dev/null || fail "fastdds not found (fastdds-tools)"
 
 fleet_netns_up "$name" 2 || fail "namespaces not made"
 server="$(fleet_netns_addr "$name" shore)"

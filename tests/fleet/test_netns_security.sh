@@ -13,36 +13,18 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 probe="$1"
 qos="$2"
 make_security="$3"
-# shellcheck source=netns.sh
-source "$here/netns.sh"
-if ! reason="$(fleet_netns_check)"; then
-  echo "SKIP: $reason"
-  exit 77
-fi
-
-name="sc$(( $$ % 100000 ))"
-work="$(mktemp -d)"
-cleanup() {
-  fleet_netns_down "$name"
-  rm -rf "$work"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do
-    [ -f "$f" ] && { echo "--- $(basename "$f")"; tail -n 20 "$f"; }
-  done
-  exit 1
-}
+# shellcheck source=netns_preamble.sh
+source "$here/netns_preamble.sh"
+netns_test_begin sc 20
 
 fleet_netns_up "$name" 2 || fail "namespaces not made"
 peers="$(fleet_netns_addr "$name" shore),$(fleet_netns_addr "$name" v1),$(fleet_netns_addr "$name" v2)"
-"$make_security" "$work/fleet" --identity vessel:vessel --identity shore:shore \
+"$make_security" "$work/fleet" --identity vessel:vessel:257000001 --identity shore:shore:257000001 \
   --initial-peers "$peers" >"$work/pki.log" 2>&1 || fail "make-security.sh (fleet)"
-"$make_security" "$work/foreign" --ca-name "foreign CA" --identity shore:shore \
+"$make_security" "$work/foreign" --ca-name "foreign CA" --identity 'shore:shore:*' \
   --initial-peers "$peers" >>"$work/pki.log" 2>&1 || fail "make-security.sh (foreign)"
-dds=(--qos "$qos" --domain 7 --partition fleet)
+# The vessel's partition: its identity may publish nowhere else.
+dds=(--qos "$qos" --domain 7 --partition vessel-257000001)
 
 fleet_netns_exec "$name" v1 "$probe" sidecar "${dds[@]}" --security "$work/fleet/security_profiles.xml" \
   --participant-profile usv_fdi_secure_vessel_unicast --mmsi 257000001 --sensors 2 --timeout 60 \

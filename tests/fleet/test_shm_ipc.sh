@@ -15,29 +15,13 @@ set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 probe="$1"
 qos="$2"
-# shellcheck source=netns.sh
-source "$here/netns.sh"
-if ! reason="$(fleet_netns_check)"; then
-  echo "SKIP: $reason"
-  exit 77
-fi
+# shellcheck source=netns_preamble.sh
+source "$here/netns_preamble.sh"
+netns_test_begin sh 10
 if ! unshare --mount sh -c 'mount -t tmpfs tmpfs /dev/shm' 2>/dev/null; then
   echo "SKIP: cannot make a private /dev/shm (unshare --mount; mount tmpfs)"
   exit 77
 fi
-name="sh$(( $$ % 100000 ))"
-work="$(mktemp -d)"
-cleanup() {
-  fleet_netns_down "$name"
-  rm -rf "$work"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-fail() {
-  echo "FAIL: $*"
-  for f in "$work"/*.log; do [ -f "$f" ] && { echo "--- $(basename "$f")"; tail -n 10 "$f"; }; done
-  exit 1
-}
 fleet_netns_up "$name" 1 || fail "namespace not made"
 export FASTRTPS_DEFAULT_PROFILES_FILE="$here/../../docker/fleet_participants.xml"
 export ROS_DISCOVERY_SERVER="127.0.0.1:11811"

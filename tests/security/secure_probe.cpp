@@ -48,6 +48,7 @@
 #include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/log/StdoutErrConsumer.hpp>
 
+#include "probe_common.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 #include "usv_fdi/dds/profiles.hpp"
 
@@ -58,15 +59,11 @@ using usv_fdi::dds::DdsConfig;
 using usv_fdi::dds::DdsContext;
 namespace profiles = usv_fdi::dds::profiles;
 using Clock = std::chrono::steady_clock;
-
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "signal flag must be lock free");
-
-extern "C" void on_signal(int) { g_stop.store(true); }  // async-signal-safe
-
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using usv_fdi::test_support::probe::deadline_after;
+using usv_fdi::test_support::probe::g_stop;
+using usv_fdi::test_support::probe::install_signal_handlers;
+using usv_fdi::test_support::probe::parse_unsigned;
+using usv_fdi::test_support::probe::UsageError;
 
 struct Options {
   std::string mode;
@@ -82,17 +79,6 @@ struct Options {
   unsigned until_faults = 0;
   double timeout_s = 30.0;
 };
-
-unsigned long parse_unsigned(const std::string& flag, const std::string& value) {
-  try {
-    std::size_t used = 0;
-    const unsigned long v = std::stoul(value, &used);
-    if (used != value.size()) throw std::invalid_argument(value);
-    return v;
-  } catch (const std::exception&) {
-    throw UsageError(flag + ": not an unsigned integer: '" + value + "'");
-  }
-}
 
 double parse_seconds(const std::string& flag, const std::string& value) {
   try {
@@ -158,10 +144,7 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-Clock::time_point after(double seconds) {
-  return Clock::now() +
-         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-}
+Clock::time_point after(double seconds) { return deadline_after(seconds); }
 
 void say(const std::string& line) {
   std::printf("%s\n", line.c_str());
@@ -321,14 +304,6 @@ int run_peer(const Options& o) {
       std::to_string(ins_written) + " acks_written=" + std::to_string(acks_written) +
       " first_fault_ms=" + std::to_string(first_fault_ms));
   return 0;
-}
-
-void install_signal_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGTERM, &sa, nullptr);
-  sigaction(SIGINT, &sa, nullptr);
 }
 
 }  // namespace

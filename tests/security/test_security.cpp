@@ -57,6 +57,9 @@ Result run(const std::vector<std::string>& argv, milliseconds timeout) {
   return r;
 }
 
+/// The prefix of this process's vessel partitions (make-security.sh --partition-prefix).
+std::string partition_prefix() { return "usv_fdi_security_" + std::to_string(::getpid()) + "_"; }
+
 /// Makes the two PKIs once for the whole test program, removes them at the end.
 class PkiEnvironment : public ::testing::Environment {
  public:
@@ -67,14 +70,18 @@ class PkiEnvironment : public ::testing::Environment {
     g_pki = fs::path(USV_FDI_SECURITY_WORKDIR) / ("pki-" + std::to_string(::getpid()));
     fs::remove_all(g_pki);
     fs::create_directories(g_pki);
-    const Result fleet = run({USV_FDI_MAKE_SECURITY, (g_pki / "fleet").string(), "--identity",
-                              "vessel:vessel", "--identity", "sensors:sensors", "--identity",
-                              "shore:shore", "--identity", "observer:observer"},
+    // Every right confined to the vessel partitions of this process (prefix from the pid).
+    const std::string v = std::to_string(kVessel);
+    const Result fleet = run({USV_FDI_MAKE_SECURITY, (g_pki / "fleet").string(),
+                              "--partition-prefix", partition_prefix(), "--identity",
+                              "vessel:vessel:" + v, "--identity", "sensors:sensors:" + v,
+                              "--identity", "shore:shore:" + v, "--identity", "observer:observer"},
                              milliseconds(60000));
     ASSERT_EQ(fleet.code, 0) << fleet.out;
-    const Result foreign = run({USV_FDI_MAKE_SECURITY, (g_pki / "foreign").string(), "--ca-name",
-                                "foreign CA", "--identity", "shore:shore"},
-                               milliseconds(60000));
+    const Result foreign =
+        run({USV_FDI_MAKE_SECURITY, (g_pki / "foreign").string(), "--partition-prefix",
+             partition_prefix(), "--ca-name", "foreign CA", "--identity", "shore:shore:" + v},
+            milliseconds(60000));
     ASSERT_EQ(foreign.code, 0) << foreign.out;
   }
   void TearDown() override {
@@ -88,10 +95,8 @@ std::string fleet_profiles() { return (g_pki / "fleet" / "security_profiles.xml"
 std::string foreign_profiles() { return (g_pki / "foreign" / "security_profiles.xml").string(); }
 
 std::uint32_t domain_id() { return 1 + static_cast<std::uint32_t>(::getpid()) % 200; }
-std::string partition() {
-  static std::atomic<unsigned> n{0};
-  return "usv_fdi_security_" + std::to_string(::getpid()) + "_" + std::to_string(n++);
-}
+/// The vessel's partition, in this process's namespace: the permissions allow no other.
+std::string partition() { return partition_prefix() + "vessel-" + std::to_string(kVessel); }
 
 /// Participant arguments: a secure identity of `profiles`, or none (plain participant).
 std::vector<std::string> who(const std::string& profiles, const std::string& identity) {

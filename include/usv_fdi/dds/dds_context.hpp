@@ -20,6 +20,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 
+#include "usv_fdi/dds/peers.hpp"
 #include "usv_fdi/dds/profiles.hpp"
 #include "usv_fdi/dds/types.hpp"
 
@@ -70,6 +71,10 @@ class DdsContext {
   eprosima::fastdds::dds::Publisher& publisher() const noexcept { return *publisher_; }
   eprosima::fastdds::dds::Subscriber& subscriber() const noexcept { return *subscriber_; }
   eprosima::fastdds::dds::Topic& topic(TopicId id) const;
+  /// The remote participants' identities and writers' partitions (the participant's listener).
+  const PeerDirectory& peers() const noexcept { return *peers_; }
+  /// True if the participant runs DDS Security (its profile sets an authentication plugin).
+  bool secure() const;
 
   /// Creates a data writer on topic `id` from data writer profile `profile`. The writer is owned
   /// by the context (deleted with it, or earlier by delete_writer()).
@@ -77,6 +82,10 @@ class DdsContext {
       TopicId id, const std::string& profile,
       eprosima::fastdds::dds::DataWriterListener* listener = nullptr,
       const eprosima::fastdds::dds::StatusMask& mask = eprosima::fastdds::dds::StatusMask::all());
+  /// Like create_writer(), on a publisher of its own in `partitions` instead of the configured
+  /// ones (e.g. an acknowledgement written into one vessel's partition only).
+  eprosima::fastdds::dds::DataWriter& create_writer_in_partitions(
+      TopicId id, const std::string& profile, const std::vector<std::string>& partitions);
   /// Creates a data reader on topic `id` from data reader profile `profile`; see create_writer().
   eprosima::fastdds::dds::DataReader& create_reader(
       TopicId id, const std::string& profile,
@@ -103,6 +112,7 @@ class DdsContext {
   };
 
   DdsConfig config_;
+  std::unique_ptr<PeerDirectory> peers_;  ///< outlives the participant (its listener)
   std::unique_ptr<eprosima::fastdds::dds::DomainParticipant, ParticipantDeleter> participant_;
   std::array<eprosima::fastdds::dds::Topic*, kTopicCount> topics_{};
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
