@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "open_output.hpp"
 #include "sim_voyage.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
@@ -228,13 +229,9 @@ int run_sim(const SimArgs& a) {
   }
 
   const bool to_stdout = a.output == "-";
-  std::unique_ptr<io::OutputFile> output;  // a temporary file renamed at the end
-  try {
-    output = std::make_unique<io::OutputFile>(a.output);
-  } catch (const io::OutputError& e) {
-    spdlog::error("{}", e.what());
-    return kExitOutput;
-  }
+  // A temporary file renamed at the end.
+  const std::unique_ptr<io::OutputFile> output = open_output(a.output);
+  if (output == nullptr) return kExitOutput;
   io::SimCsvWriter writer(output->stream());
   SimRow row;
   std::size_t rows = 0;
