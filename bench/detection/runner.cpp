@@ -302,18 +302,23 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
                     kInsSigmaR);
       std::string note = buf;
       for (const std::string& voyage : p.voyages) note += " " + voyage;
+      // A case of this table on that voyage, with the next seed.
+      const auto voyage_case = [&](const std::string& voyage) {
+        Case c;
+        c.table = table;
+        c.note = note;
+        c.subject = sub.name;
+        c.voyage = voyage;
+        c.rate_hz = rate;
+        c.seed = mix_seed(++serial);
+        c.B = sub.lin.B;
+        c.A_ref = sub.lin.A;
+        return c;
+      };
       for (const std::string& voyage : p.voyages) {
         for (int h = 0; h < p.healthy_seeds; ++h) {
-          Case c;
-          c.table = table;
-          c.note = note;
-          c.subject = sub.name;
-          c.voyage = voyage;
-          c.rate_hz = rate;
-          c.seed = mix_seed(++serial);
+          Case c = voyage_case(voyage);
           c.duration = p.healthy_len;
-          c.B = sub.lin.B;
-          c.A_ref = sub.lin.A;
           c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration] {
             return voyage_stream(hull, voyage, rate, seed, d, {});
           };
@@ -327,19 +332,11 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
           for (Sensor sensor : {Sensor::kAccelerometer, Sensor::kGyro}) {
             const double sigma = sensor == Sensor::kAccelerometer ? kInsSigmaV : kInsSigmaR;
             for (const FaultSpec& spec : standard_faults(sigma)) {
-              Case c;
-              c.table = table;
-              c.note = note;
-              c.subject = sub.name;
-              c.voyage = voyage;
-              c.rate_hz = rate;
-              c.seed = mix_seed(++serial);
+              Case c = voyage_case(voyage);
               c.faulty = true;
               c.fault = InjectedFault{sensor, spec.kind, onset, onset + p.fault_len};
               c.magnitude = spec.magnitude;
               c.duration = onset + p.fault_len + p.tail;
-              c.B = sub.lin.B;
-              c.A_ref = sub.lin.A;
               FaultInjection fi;
               fi.sensor = sensor;
               fi.kind = spec.kind;

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "commands.hpp"
+#include "open_output.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/io/jsonl.hpp"
@@ -86,13 +87,8 @@ int run_replay(const ReplayArgs& a) {
     return kExitInput;
   }
 
-  std::unique_ptr<io::OutputFile> output;
-  try {
-    output = std::make_unique<io::OutputFile>(a.output);
-  } catch (const io::OutputError& e) {
-    spdlog::error("{}", e.what());
-    return kExitOutput;
-  }
+  const std::unique_ptr<io::OutputFile> output = open_output(a.output);
+  if (output == nullptr) return kExitOutput;
   io::JsonlWriter writer(output->stream());
 
   int code = kExitOk;

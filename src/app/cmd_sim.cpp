@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "open_output.hpp"
 #include "sim_voyage.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
@@ -33,17 +34,15 @@
 namespace usvfdi::app {
 namespace {
 
-struct SimArgs {
-  std::string vessel = "otter";
-  std::string scenario = "paper";
-  double rate_hz = 50.0;
-  std::optional<double> duration;
-  std::uint64_t seed = 1;
-  std::vector<std::string> faults;
+/// The options every scenario takes (VoyageCommon: vessel, scenario, output, rate, duration,
+/// seed, noise scale, faults), then those of the classic scenarios, the voyages and --publish.
+struct SimArgs : VoyageCommon {
+  SimArgs() {
+    vessel = "otter";
+    scenario = "paper";
+  }
   std::string steering;  ///< empty: the scenario's
-  double noise_scale = 1.0;
-  std::string output;
-  VoyageArgs voyage;  ///< options of the voyage scenarios (sim_voyage.cpp)
+  VoyageArgs voyage;     ///< options of the voyage scenarios (sim_voyage.cpp)
 #ifdef USV_FDI_APP_WITH_DDS
   bool publish = false;
   std::vector<std::uint32_t> mmsi;
@@ -98,16 +97,7 @@ int run_voyage_scenario(const SimArgs& a) {
     spdlog::error("sim: give --output FILE");
     return kExitUsage;
   }
-  VoyageCommon c;
-  c.vessel = a.vessel;
-  c.scenario = a.scenario;
-  c.output = a.output;
-  c.rate_hz = a.rate_hz;
-  c.duration = a.duration;
-  c.seed = a.seed;
-  c.noise_scale = a.noise_scale;
-  c.faults = a.faults;
-  return run_voyage_sim(c, a.voyage);
+  return run_voyage_sim(a, a.voyage);
 }
 
 int run_sim(const SimArgs& a) {
@@ -239,13 +229,9 @@ int run_sim(const SimArgs& a) {
   }
 
   const bool to_stdout = a.output == "-";
-  std::unique_ptr<io::OutputFile> output;  // a temporary file renamed at the end
-  try {
-    output = std::make_unique<io::OutputFile>(a.output);
-  } catch (const io::OutputError& e) {
-    spdlog::error("{}", e.what());
-    return kExitOutput;
-  }
+  // A temporary file renamed at the end.
+  const std::unique_ptr<io::OutputFile> output = open_output(a.output);
+  if (output == nullptr) return kExitOutput;
   io::SimCsvWriter writer(output->stream());
   SimRow row;
   std::size_t rows = 0;

@@ -1,5 +1,11 @@
 #include "usv_fdi/dds/profiles.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <mutex>
 #include <set>
 #include <stdexcept>
@@ -58,10 +64,24 @@ void load_profiles_file(const std::string& path) {
   std::lock_guard<std::mutex> lock(registry_mutex());
   load_default_profiles_locked();
   if (loaded_files().count(path) != 0) return;
+  // Fast DDS only logs that it could not open the file; name the system's reason first.
+  int err = 0;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  struct stat st {};
+  if (fd < 0 || ::fstat(fd, &st) != 0) {
+    err = errno;
+  } else if (S_ISDIR(st.st_mode)) {
+    err = EISDIR;
+  }
+  if (fd >= 0) ::close(fd);
+  if (err != 0) {
+    throw std::runtime_error("usv_fdi::dds: cannot read the XML profiles file '" + path +
+                             "': " + std::strerror(err));
+  }
   if (factory().load_XML_profiles_file(path) != ReturnCode_t::RETCODE_OK) {
     throw std::runtime_error("usv_fdi::dds: Fast DDS rejected the XML profiles file '" + path +
-                             "' (missing, malformed or duplicate profile names; see the Fast DDS "
-                             "error log)");
+                             "' (malformed or duplicate profile names; see the Fast DDS error "
+                             "log)");
   }
   loaded_files().insert(path);
 }

@@ -1,6 +1,7 @@
 #include "usv_fdi/dds_service/health.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
@@ -9,7 +10,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -110,11 +110,15 @@ HealthVerdict check_health_file(const std::string& path, double max_age, double 
     v.line = "unhealthy: " + why;
     return v;
   };
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) {
-    return bad("no health file " + path + " (is `usv-fdi run --health-file " + path +
-               "` running?)");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) {
+      return bad("no health file " + path + " (is `usv-fdi run --health-file " + path +
+                 "` running?)");
+    }
+    return bad("cannot read " + path + ": " + std::strerror(errno));
   }
+  if (S_ISDIR(st.st_mode)) return bad("cannot read " + path + ": " + std::strerror(EISDIR));
   std::ifstream f(path);
   if (!f) return bad("cannot read " + path + ": " + std::strerror(errno));
   std::stringstream ss;

@@ -1,7 +1,13 @@
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -68,8 +74,15 @@ ServiceConfig load_service_config(const std::string& path) {
       {"qos_profiles",
        [&](const ConfigValue& v) {
          qos = relative_to_config(v.text("a file path"));
-         std::error_code ec;
-         if (!std::filesystem::exists(qos, ec)) v.fail("no such file: " + qos);
+         // Readable as a file now, or the operating system's reason (EISDIR: open(2) takes a
+         // directory for reading).
+         const int fd = ::open(qos.c_str(), O_RDONLY | O_CLOEXEC);
+         struct stat st {};
+         const bool opened = fd >= 0 && ::fstat(fd, &st) == 0;
+         const int err = !opened ? errno : S_ISDIR(st.st_mode) ? EISDIR : 0;
+         if (fd >= 0) ::close(fd);
+         if (err == ENOENT) v.fail("no such file: " + qos);
+         if (err != 0) v.fail("cannot read " + qos + ": " + std::strerror(err));
        }},
       {"participant_profile",
        [&](const ConfigValue& v) { cfg.dds.participant_profile = v.text("a profile name"); }},

@@ -77,13 +77,8 @@ class Container final : public detail::HullWithFacts {
 
 /// Shaft speed [rps] whose thrust balances the resistance at U (bisection on X(n) = 0).
 double shaft_speed_for(double U) {
-  double lo = 0.05, hi = 10.0;  // [rps]
-  if (forces(1, 0, 0, 0, hi, U).X < 0) throw std::runtime_error("container: no shaft speed");
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (forces(1, 0, 0, 0, mid, U).X < 0 ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return detail::balancing_shaft_speed("container", 0.05, 10.0,
+                                       [U](double n) { return forces(1, 0, 0, 0, n, U).X; });
 }
 }  // namespace
 

@@ -58,14 +58,10 @@ class EssoTanker final : public detail::HullWithFacts {
   double n0_;  ///< shaft speed at throttle 1 [rps]
 };
 
+/// Shaft speed [rps] whose thrust balances the resistance at U (bisection on du(n) = 0).
 double shaft_speed_for(double U) {
-  double lo = 0.01, hi = 5.0;  // [rps]
-  if (tanker_rates(U, 0, 0, 0, hi).du < 0) throw std::runtime_error("tanker: no shaft speed");
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (tanker_rates(U, 0, 0, 0, mid).du < 0 ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  return detail::balancing_shaft_speed("tanker", 0.01, 5.0,
+                                       [U](double n) { return tanker_rates(U, 0, 0, 0, n).du; });
 }
 }  // namespace
 

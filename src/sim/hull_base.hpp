@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "usv_fdi/sim/hull.hpp"
@@ -44,6 +45,19 @@ inline void solve_sway_yaw(double m22, double m23, double m32, double m33, doubl
   const double det = m22 * m33 - m23 * m32;
   *dv = (m33 * Y - m23 * N) / det;
   *dr = (m22 * N - m32 * Y) / det;
+}
+
+/// The shaft speed [rps] in [lo, hi] at which a surge force (or acceleration) that rises with
+/// the shaft speed, surge(n), is zero: the thrust that balances the resistance. 200 bisection
+/// steps; throws "<hull>: no shaft speed" if even hi leaves surge(hi) < 0.
+template <class Surge>
+double balancing_shaft_speed(const char* hull, double lo, double hi, Surge surge) {
+  if (surge(hi) < 0) throw std::runtime_error(std::string(hull) + ": no shaft speed");
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (surge(mid) < 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 }  // namespace usvfdi::sim::detail

@@ -115,8 +115,37 @@ TEST(XmlProfiles, UnknownQosElementIsRejected) {
   EXPECT_FALSE(ErrorCollector::take().empty());
 }
 
+/// The message load_profiles_file throws for path ("" if it does not throw).
+std::string load_error(const std::string& path) {
+  try {
+    load_profiles_file(path);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(XmlProfiles, MissingFileIsRejected) {
   EXPECT_THROW(load_profiles_file("/nonexistent/usv_fdi_profiles.xml"), std::runtime_error);
+}
+
+TEST(XmlProfiles, AnUnreadableFileIsRejectedWithTheSystemsReason) {
+  // The reasons of open(2), each provoked whatever the user (root ignores mode bits).
+  const std::string file = write_temp("plain", "not a directory");
+  struct Case {
+    std::string path, reason;
+  };
+  const Case cases[] = {
+      {"/nonexistent/usv_fdi_profiles.xml", "No such file or directory"},
+      {file + "/profiles.xml", "Not a directory"},
+      {::testing::TempDir(), "Is a directory"},
+  };
+  for (const Case& c : cases) {
+    const std::string what = load_error(c.path);
+    EXPECT_NE(what.find("cannot read the XML profiles file '" + c.path + "': " + c.reason),
+              std::string::npos)
+        << what;
+  }
 }
 
 TEST(XmlProfiles, FaultEventQosIsAsSpecified) {

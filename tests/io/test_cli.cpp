@@ -2,7 +2,6 @@
 // codes and messages on bad input.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -17,25 +16,16 @@
 #include <vector>
 
 #include "json_lite.hpp"
+#include "support/run_cli.hpp"
 
 namespace usvfdi::io {
 namespace {
 
 namespace js = usvfdi::testing_json;
-const std::string kExe = USV_FDI_EXE;
-const std::string kSource = USV_FDI_SOURCE_DIR;
-
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream os;
-  os << f.rdbuf();
-  return os.str();
-}
+using testing_cli::kExe;
+using testing_cli::kSource;
+using testing_cli::Outcome;
+using testing_cli::slurp;
 
 void spit(const std::string& path, const std::string& text) {
   std::ofstream f(path, std::ios::binary);
@@ -63,14 +53,7 @@ class Cli : public ::testing::Test {
 
   /// Runs shell commands, collecting their exit code, stdout and stderr.
   Outcome shell(const std::string& commands) const {
-    Outcome r;
-    const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const std::string cmd = "{ " + commands + "; } >'" + out + "' 2>'" + err + "'";
-    const int status = std::system(cmd.c_str());
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
+    return testing_cli::run_shell(commands, dir_);
   }
 
   /// A short simulated CSV (paper scenario on the Otter, 10 Hz, 30 s).

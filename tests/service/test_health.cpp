@@ -119,6 +119,22 @@ TEST(HealthFile, StaleFailedStoppedMissingAndGarbageAreUnhealthyWithTheReason) {
   EXPECT_NE(v.line.find("no health file " + path), std::string::npos) << v.line;
 }
 
+TEST(HealthFile, AHealthFileThatCannotBeReadIsNamedWithTheSystemsReason) {
+  // Reasons provoked whatever the user (root ignores mode bits): a path under a plain file, a
+  // directory. Neither is "no health file".
+  const std::string plain = temp_file("plain");
+  std::ofstream(plain) << "not a directory";
+  const std::string under = plain + "/health.json";
+  HealthVerdict v = check_health_file(under, 10.0, unix_now());
+  EXPECT_FALSE(v.healthy);
+  EXPECT_EQ(v.line, "unhealthy: cannot read " + under + ": Not a directory");
+  const std::string dir = ::testing::TempDir();
+  v = check_health_file(dir, 10.0, unix_now());
+  EXPECT_FALSE(v.healthy);
+  EXPECT_EQ(v.line, "unhealthy: cannot read " + dir + ": Is a directory");
+  fs::remove(plain);
+}
+
 TEST(HealthFile, JudgeNamesEveryStalledThread) {
   HealthReport r = running_report();
   judge_threads(&r);

@@ -123,6 +123,12 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
       {"  rudder_wait: -1", "4: service.rudder_wait = -1: must be a positive time"},
       {"  reliable_inputs: maybe", "4: service.reliable_inputs = maybe: must be true or false"},
       {"  qos_profiles: missing.xml", "4: service.qos_profiles = missing.xml: no such file"},
+      {"  qos_profiles: " + kSource + "/README.md/qos.xml",
+       "4: service.qos_profiles = " + kSource + "/README.md/qos.xml: cannot read " + kSource +
+           "/README.md/qos.xml: Not a directory"},
+      {"  qos_profiles: " + kSource + "/config", "4: service.qos_profiles = " + kSource +
+                                                     "/config: cannot read " + kSource +
+                                                     "/config: Is a directory"},
       {"  mmsi: 1\n  colour: red", "5: service.colour = colour: unknown key"},
       {"  input_timeout: 0.2",
        "4: service.input_timeout = 0.2: must be at least isolation.stale_timeout (0.5 s)"},

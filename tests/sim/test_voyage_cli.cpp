@@ -1,29 +1,18 @@
 // usv-fdi sim with voyage scenarios, end to end: the CSV, its determinism, replay of it, and
 // the messages on bad options.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 
+#include "support/run_cli.hpp"
+
 namespace {
-const std::string kExe = USV_FDI_EXE;
-const std::string kSource = USV_FDI_SOURCE_DIR;
-
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::ostringstream os;
-  os << f.rdbuf();
-  return os.str();
-}
+using usvfdi::testing_cli::kExe;
+using usvfdi::testing_cli::kSource;
+using usvfdi::testing_cli::Outcome;
+using usvfdi::testing_cli::slurp;
 
 class VoyageCli : public ::testing::Test {
  protected:
@@ -39,14 +28,7 @@ class VoyageCli : public ::testing::Test {
   }
   std::string path(const std::string& name) const { return dir_ + name; }
   Outcome run(const std::string& args) const {
-    Outcome r;
-    const std::string out = path("stdout.txt"), err = path("stderr.txt");
-    const int status =
-        std::system(("'" + kExe + "' " + args + " >'" + out + "' 2>'" + err + "'").c_str());
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
+    return usvfdi::testing_cli::run_shell("'" + kExe + "' " + args, dir_);
   }
   std::string dir_;
 };
