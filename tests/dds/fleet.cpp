@@ -91,11 +91,16 @@ std::string Fleet::write_service_config(const std::string& name, unsigned mmsi,
   const std::string path = dir_ + name + ".yaml";
   std::ofstream f(path);
   f << slurp(std::string(USV_FDI_SOURCE_DIR) + "/config/scenarios/paper.yaml");
-  f << "\nservice:\n  mmsi: " << mmsi << "\n  reliable_inputs: true\n  status_rate: 5\n";
-  bool own_state = false;
-  for (const auto& line : extra) own_state |= line.rfind("state_dir:", 0) == 0;
-  // Each sidecar config gets a state directory of its own (never the host's default).
-  if (!own_state) f << "  state_dir: " << state_dir(name) << "\n";
+  f << "\nservice:\n  mmsi: " << mmsi << "\n";
+  // The defaults, unless a line of `extra` gives the key (the loader refuses a key given
+  // twice). Each sidecar config gets a state directory of its own (never the host's default).
+  const std::pair<std::string, std::string> defaults[] = {
+      {"reliable_inputs", "true"}, {"status_rate", "5"}, {"state_dir", state_dir(name)}};
+  for (const auto& [key, value] : defaults) {
+    bool given = false;
+    for (const auto& line : extra) given |= line.rfind(key + ":", 0) == 0;
+    if (!given) f << "  " << key << ": " << value << "\n";
+  }
   for (const auto& line : extra) f << "  " << line << "\n";
   if (!f) throw std::runtime_error("cannot write " + path);
   return path;
