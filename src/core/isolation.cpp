@@ -41,6 +41,28 @@ double robust_std(std::vector<double>* v) {
   return 1.4826 * median(&dev);
 }
 
+/// Time after a restart from the measurements until the restart's transient has faded
+/// from the observer's residual: the initial error is the noise of the measurements it
+/// was restarted from (up to 3 sigma in either state, either sign), and its residual c e_k
+/// (e_{k+1} = Ad e_k, steps of dt) must stay below half a sigma of the channel's residual
+/// from then on. The unmeasured state's error reaches the residual only through the
+/// coupling (and is corrected as slowly): for a weak coupling against noisy data this
+/// takes longer than the settling after arming, which learning follows.
+double restart_transient(const DedicatedObserver& o, double dt, const Vec2& sigma) {
+  const int c = o.channel();
+  const int horizon = static_cast<int>(std::ceil(120.0 / dt));
+  int last_above = -1;
+  for (const double sv : {-1.0, 1.0}) {
+    Vec2 e(3.0 * sigma(0), sv * 3.0 * sigma(1));
+    for (int k = 0; k < horizon; ++k) {
+      if (!e.allFinite()) return 120.0;
+      if (std::abs(e(c)) > 0.5 * sigma(c)) last_above = k;
+      e = o.Ad() * e;
+    }
+  }
+  return last_above < 0 ? 0.0 : (last_above + 1) * dt;
+}
+
 }  // namespace
 
 void IsolationParams::validate() const {
@@ -390,7 +412,15 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
     const Vec2 y0(v_ok ? s.v : b->v.x()(0), r_ok ? s.r : b->g.x()(1));
     b->v.reset(y0);
     b->g.reset(y0);
-    b->settle_until = s.t + settle_time_;
+    // Detection pauses until that restart has settled (at least settle_time): the step
+    // length of the observers' discretisation is the sample interval before the gap.
+    const Vec2 sigma = b->scales_learned ? b->sigma_s : b->floor_s;
+    double settle = settle_time_;
+    if (b->v.dt() > 0 && b->g.dt() > 0 && sigma.allFinite() && (sigma.array() > 0).all()) {
+      settle = std::max({settle, restart_transient(b->v, b->v.dt(), sigma),
+                         restart_transient(b->g, b->g.dt(), sigma)});
+    }
+    b->settle_until = s.t + settle;
     return;
   }
   const double d = usable(prev_.delta, p_.max_abs_delta) ? prev_.delta

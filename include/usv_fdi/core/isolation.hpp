@@ -31,11 +31,15 @@ struct IsolationParams {
   double redesign_tolerance = 0.005;  ///< relative change of A that triggers a redesign
   /// Sensor noise. The residual scales are always learned on healthy data after arming
   /// (they include model mismatch); configured sensor noise sets their floors.
-  double sigma_v = 0.0;           ///< accelerometer-channel noise [m/s]; 0: floors only
-  double sigma_r = 0.0;           ///< gyro noise [rad/s]; 0: floors only
-  double sigma_floor_v = 1e-4;    ///< floor of every v-channel scale [m/s]
-  double sigma_floor_r = 1e-5;    ///< floor of every r-channel scale [rad/s]
-  double settle_time = -1;        ///< observer settling after arming [s]; <0: 3 / min|pole|
+  double sigma_v = 0.0;         ///< accelerometer-channel noise [m/s]; 0: floors only
+  double sigma_r = 0.0;         ///< gyro noise [rad/s]; 0: floors only
+  double sigma_floor_v = 1e-4;  ///< floor of every v-channel scale [m/s]
+  double sigma_floor_r = 1e-5;  ///< floor of every r-channel scale [rad/s]
+  /// Observer settling after arming [s]; <0: 3 / min|pole|. After an input gap longer than
+  /// stale_timeout the observers restart from the measurements and detection pauses for at
+  /// least this, longer while the restart's transient (3-sigma noise in the state a channel
+  /// does not measure) is above half a sigma of the residual.
+  double settle_time = -1;
   double learn_time = 60.0;       ///< healthy data used to learn scales and threshold [s]
   double window = 0.5;            ///< evaluation window J_N [s]
   int min_window_samples = 10;    ///< the window holds at least this many samples

@@ -56,6 +56,8 @@ class DedicatedObserver {
   /// Discrete matrices for the last step length (valid after the first step): the error
   /// transition Phi - L e_c^T, the measurement gain L, and the open-loop Phi, Ga, Gb.
   const Mat2& Ad() const { return Ad_; }
+  /// The step length Ad, Gy, Phi, Ga and Gb are for (<= 0 before the first step).
+  double dt() const { return dt_; }
   const Vec2& Gy() const { return Gy_; }
   const Mat2& Phi() const { return Phi_; }
   const Vec2& Ga() const { return Ga_; }
