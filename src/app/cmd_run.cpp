@@ -2,6 +2,7 @@
 #include <spdlog/async.h>
 #include <spdlog/spdlog.h>
 
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -268,7 +269,9 @@ int run_service_logged(const RunArgs& a) {
   AsyncLogging logging;
   const int code = run_service(a, logging);
   // Everything is stopped and saved; only the log may be stuck behind an unread stderr.
-  if (!logging.finish(kLogDrainAtExit)) ::_exit(code);
+  // Exit without touching stdio: ThreadSanitizer's _exit interceptor flushes stderr first,
+  // which waits for the stdio lock that the blocked logging thread holds.
+  if (!logging.finish(kLogDrainAtExit)) ::syscall(SYS_exit_group, code);
   return code;
 }
 

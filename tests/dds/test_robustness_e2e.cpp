@@ -19,9 +19,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -654,7 +656,17 @@ TEST(UnreadStderr, TheSidecarStillPublishesAndStopsOnSigterm) {
   ASSERT_GT(filled, 0u);
   std::vector<std::string> argv = {USV_FDI_EXE, "run", "--config", cfg};
   for (const auto& x : f.dds_args()) argv.push_back(x);
-  auto svc = std::make_unique<ChildProcess>(argv, "/proc/self/fd/" + std::to_string(fds[1]));
+  // A sanitizer's runtime writes its reports (and TSan its summary at _exit) straight to
+  // stderr, where it would block on this pipe: under a sanitizer build they go to a file,
+  // checked below (a report still makes the exit code non-zero).
+  std::vector<std::string> san_env;
+  for (const char* name : {"TSAN_OPTIONS", "ASAN_OPTIONS", "UBSAN_OPTIONS"}) {
+    if (const char* v = std::getenv(name)) {
+      san_env.push_back(std::string(name) + "=" + v + ":log_path=" + f.dir() + "sanitizer-svc");
+    }
+  }
+  auto svc =
+      std::make_unique<ChildProcess>(argv, "/proc/self/fd/" + std::to_string(fds[1]), san_env);
   ::close(fds[1]);
   ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
   // AND much to log: refused acks (some lines in full) and a voyage with its events
@@ -691,6 +703,13 @@ TEST(UnreadStderr, TheSidecarStillPublishesAndStopsOnSigterm) {
   EXPECT_EQ(*code, 0);
   std::printf("with stderr unread: stopped %.3f s after SIGTERM\n", took);
   ::close(fds[0]);
+  for (const auto& e : std::filesystem::directory_iterator(f.dir())) {
+    if (e.path().filename().string().rfind("sanitizer-svc", 0) == 0) {
+      std::ifstream in(e.path());
+      const std::string report((std::istreambuf_iterator<char>(in)), {});
+      EXPECT_TRUE(report.empty()) << e.path() << ":\n" << report;
+    }
+  }
 }
 
 // ------------------------------------------------------------------ burst loss
