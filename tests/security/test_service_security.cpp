@@ -204,8 +204,10 @@ class ServiceSecurity : public ::testing::Test {
     {
       std::ofstream f(cfg);
       f << slurp(kSource + "/config/scenarios/paper.yaml");
+      // lockstep: detection independent of the threads' scheduling, since the tests compare
+      // the events with the voyage's faults (a loaded machine must not change them)
       f << "\nservice:\n  mmsi: " << kMmsi
-        << "\n  reliable_inputs: true\n  status_rate: 5\n  input_timeout: 60\n";
+        << "\n  reliable_inputs: true\n  lockstep: true\n  status_rate: 5\n  input_timeout: 60\n";
     }
     ChildProcess& p = start("sidecar", fleet_id("vessel"), {"run", "--config", cfg});
     EXPECT_TRUE(wait_for_log("sidecar", "waiting for INS and rudder", seconds(20)))
@@ -648,9 +650,15 @@ TEST_F(ServiceSecurity, ExpiredCredentialsEndTheSessionsAlreadyOpen) {
   // THEN both leave the domain within a few of their loop periods (0.5 s, 0.2 s) of the expiry,
   // saying why, with exit code 1 (an orchestrator restarts them, with renewed credentials or not)
   const auto limit = seconds(kGrant + 30);
+  // The monitor prints its status 5 times a second: keep reading its stdout meanwhile, or the
+  // pipe fills and the monitor blocks in write(2) instead of watching its expiry.
+  std::thread drain([&mon, limit] {
+    (void)mon.read_all(std::chrono::duration_cast<milliseconds>(limit + seconds(10)));
+  });
   const auto side_code = side.wait_exit(std::chrono::duration_cast<milliseconds>(limit));
   const double side_late =
       std::chrono::duration<double>(std::chrono::system_clock::now() - expires).count();
+  drain.join();  // the monitor's stdout ended (it exited) or the limit passed
   const auto mon_code = mon.wait_exit(seconds(10));
   const double mon_late =
       std::chrono::duration<double>(std::chrono::system_clock::now() - expires).count();
