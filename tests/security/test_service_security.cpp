@@ -204,10 +204,8 @@ class ServiceSecurity : public ::testing::Test {
     {
       std::ofstream f(cfg);
       f << slurp(kSource + "/config/scenarios/paper.yaml");
-      // lockstep: detection independent of the threads' scheduling, since the tests compare
-      // the events with the voyage's faults (a loaded machine must not change them)
       f << "\nservice:\n  mmsi: " << kMmsi
-        << "\n  reliable_inputs: true\n  lockstep: true\n  status_rate: 5\n  input_timeout: 60\n";
+        << "\n  reliable_inputs: true\n  status_rate: 5\n  input_timeout: 60\n";
     }
     ChildProcess& p = start("sidecar", fleet_id("vessel"), {"run", "--config", cfg});
     EXPECT_TRUE(wait_for_log("sidecar", "waiting for INS and rudder", seconds(20)))
