@@ -1,5 +1,7 @@
 #include "credentials.hpp"
 
+#include "usv_fdi/core/text.hpp"
+
 #include <openssl/asn1.h>
 #include <openssl/pem.h>
 #include <openssl/x509.h>
@@ -99,15 +101,6 @@ std::string validity_message(const CredentialExpiry& e) {
   if (!e.secure()) return std::string();
   return "DDS Security credentials valid until " + utc_text(e.not_after) +
          " (first to expire: the " + e.what + "); the session ends then";
-}
-
-std::string utc_text(double unix_s) {
-  const std::time_t t = static_cast<std::time_t>(unix_s);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
 }
 
 }  // namespace usvfdi::app

@@ -38,7 +38,4 @@ std::string expired_message(const CredentialExpiry& e);
 /// "DDS Security credentials valid until ... (first to expire: ...)", "" without security.
 std::string validity_message(const CredentialExpiry& e);
 
-/// "2026-12-01T22:15:03Z".
-std::string utc_text(double unix_s);
-
 }  // namespace usvfdi::app

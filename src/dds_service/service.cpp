@@ -289,19 +289,6 @@ bool FdiService::lock_state(const std::string& dir) {
   return true;
 }
 
-namespace {
-
-std::string utc(double unix_s) {
-  const std::time_t t = static_cast<std::time_t>(unix_s);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
-}  // namespace
-
 void FdiService::open_journal() {
   namespace fs = std::filesystem;
   const auto say = [this](int level, const std::string& msg) {
@@ -364,7 +351,7 @@ void FdiService::open_journal() {
       char age[64];
       std::snprintf(age, sizeof age, "%.1f s ago", now - c.written);
       say(1, "restored " + std::to_string(restored_.size()) + " fault instance(s) from " + path +
-                 " (written " + utc(c.written) + ", " + age + ")" +
+                 " (written " + utc_text(c.written) + ", " + age + ")" +
                  (restored_.empty() ? std::string()
                                     : ": " + list + "; re-published with the same sequences"));
       break;

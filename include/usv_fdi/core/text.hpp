@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdio>
+#include <ctime>
 #include <string>
 #include <string_view>
 
@@ -87,6 +88,16 @@ inline std::string escape_text(std::string_view s) {
     i += n;
   }
   return out;
+}
+
+/// A Unix time [s] as UTC, ISO 8601 to the second ("2026-12-01T23:52:26Z").
+inline std::string utc_text(double unix_s) {
+  const std::time_t t = static_cast<std::time_t>(unix_s);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
 }
 
 }  // namespace usvfdi
