@@ -97,7 +97,10 @@ ServiceConfig load_service_config(const std::string& path) {
          cfg.dds.subscriber_partitions = cfg.dds.publisher_partitions;
        }},
       {"reliable_inputs", [&](const ConfigValue& v) { cfg.reliable_inputs = v.boolean(); }},
-      {"lockstep", [&](const ConfigValue& v) { cfg.pipeline.lockstep = v.boolean(); }},
+      {"estimate_wait",
+       [&](const ConfigValue& v) {
+         cfg.pipeline.estimate_wait = v.number(0.0, 3600.0, "a time in s", "0 to 3600 s");
+       }},
       {"status_rate",
        [&](const ConfigValue& v) {
          cfg.pipeline.status_period =

@@ -13,11 +13,11 @@ namespace usvfdi {
 
 // ---------------------------------------------------------------- SampleAssembler
 
-void SampleAssembler::add_ins(const InsInput& s) {
+void SampleAssembler::add_ins(const InsInput& s, double arrival) {
   if (!std::isfinite(s.stamp)) return;
   auto it = ins_.end();
-  while (it != ins_.begin() && std::prev(it)->stamp > s.stamp) --it;
-  ins_.insert(it, s);
+  while (it != ins_.begin() && std::prev(it)->s.stamp > s.stamp) --it;
+  ins_.insert(it, PendingIns{s, arrival});
   // Far behind the newest (an INS clock that restarted): the newest of the old time base
   // must not hold back, nor prune the rudder samples of, the new one.
   newest_ins_ =
@@ -30,7 +30,7 @@ void SampleAssembler::add_rudder(const RudderInput& s) {
   while (it != rudder_.begin() && std::prev(it)->stamp > s.stamp) --it;
   rudder_.insert(it, s);
   // Keep what interpolation of the pending samples can still need.
-  const double oldest = ins_.empty() ? newest_ins_ : ins_.front().stamp;
+  const double oldest = ins_.empty() ? newest_ins_ : ins_.front().s.stamp;
   while (rudder_.size() > 2 && rudder_[1].stamp < oldest - timeout_) rudder_.pop_front();
 }
 
@@ -62,19 +62,20 @@ double SampleAssembler::delta_at(double t) const {
 void SampleAssembler::rebase(double t, double span) {
   const auto far = [t, span](double stamp) { return std::abs(stamp - t) > span; };
   ins_.erase(
-      std::remove_if(ins_.begin(), ins_.end(), [&](const InsInput& s) { return far(s.stamp); }),
+      std::remove_if(ins_.begin(), ins_.end(), [&](const PendingIns& p) { return far(p.s.stamp); }),
       ins_.end());
   rudder_.erase(std::remove_if(rudder_.begin(), rudder_.end(),
                                [&](const RudderInput& s) { return far(s.stamp); }),
                 rudder_.end());
-  if (far(newest_ins_)) newest_ins_ = ins_.empty() ? t : ins_.back().stamp;
+  if (far(newest_ins_)) newest_ins_ = ins_.empty() ? t : ins_.back().s.stamp;
 }
 
-void SampleAssembler::drain(std::vector<Sample>* out, bool flush) {
+void SampleAssembler::drain(std::vector<Sample>* out, bool flush, double now) {
   while (!ins_.empty()) {
-    const InsInput& s = ins_.front();
+    const InsInput& s = ins_.front().s;
     const bool later_rudder = !rudder_.empty() && rudder_.back().stamp >= s.stamp;
-    if (!(flush || later_rudder || newest_ins_ - s.stamp >= wait_)) break;
+    const bool waited = newest_ins_ - s.stamp >= wait_ && now - ins_.front().arrival >= wall_wait_;
+    if (!(flush || later_rudder || waited)) break;
     Sample out_s;
     out_s.t = s.stamp;
     out_s.v = s.v_valid ? s.v : kNaN;
@@ -182,7 +183,7 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       ident_q_(opt.ident_capacity),
       output_(opt.output_capacity),
       iso_(cfg),
-      assembler_(opt.rudder_wait, opt.rudder_timeout),
+      assembler_(opt.rudder_wait, opt.rudder_timeout, opt.rudder_wait),
       ident_(cfg) {
   incarnation_ = opt.incarnation;
 }
@@ -235,6 +236,10 @@ void FdiPipeline::stop() {
   if (pub_thread_.joinable()) pub_thread_.join();
 }
 
+double FdiPipeline::wall_seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started_at_).count();
+}
+
 void FdiPipeline::log(int level, const std::string& msg) const {
   if (on_log_) on_log_(level, msg);
 }
@@ -274,7 +279,7 @@ void FdiPipeline::accept_ins(const InsInput& in) {
                       fmt("INS t=%.3f s arrived after t=%.3f s", in.stamp, newest_ins_stamp_));
   }
   newest_ins_stamp_ = std::max(newest_ins_stamp_, in.stamp);
-  assembler_.add_ins(in);
+  assembler_.add_ins(in, wall_seconds());
 }
 
 void FdiPipeline::accept_rudder(const RudderInput& in) {
@@ -304,6 +309,7 @@ void FdiPipeline::accept_rudder(const RudderInput& in) {
 void FdiPipeline::process(const Sample& s) {
   const double prev_t = last_t_;
   events_.clear();
+  await_estimate();
   IdentificationInput handover;
   const bool ok = iso_.process(s, &events_, &handover);
   for (const Detection& d : iso_.detections()) {
@@ -360,13 +366,46 @@ void FdiPipeline::process(const Sample& s) {
         fmt("rudder: rudder angles again at t=%.3f s: identification and isolation resume", s.t));
   }
   recheck_restored(s);
-  if (opt_.lockstep) {
+  ++ident_pushed_;
+  ident_q_.push(handover);
+}
+
+void FdiPipeline::await_estimate() {
+  if (ident_pushed_ > 0) {
+    using Clock = std::chrono::steady_clock;
     std::unique_lock<std::mutex> lock(step_m_);
-    ++ident_pushed_;
-    ident_q_.push(handover);
-    step_cv_.wait(lock, [&] { return ident_done_ >= ident_pushed_; });
-  } else {
-    ident_q_.push(handover);
+    // Dropped hand-overs (a full queue, oldest first) will never be handled.
+    const auto behind = [&] {
+      const std::uint64_t settled = ident_done_ + ident_q_.dropped();
+      return settled >= ident_pushed_ ? 0 : ident_pushed_ - settled;
+    };
+    if (ident_lagging_) {
+      if (behind() == 0) {
+        ident_lagging_ = false;
+        lock.unlock();
+        log(1,
+            "identification: the identification thread has caught up: isolation again uses "
+            "the estimate of all earlier samples");
+      }
+    } else {
+      const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                               std::chrono::duration<double>(opt_.estimate_wait));
+      while (behind() > 0) {
+        const auto now = Clock::now();
+        beat_iso_.store(now_ns(), std::memory_order_relaxed);
+        if (now >= deadline) {
+          ident_lagging_ = true;
+          const std::uint64_t n = behind();
+          lock.unlock();
+          log(2, "identification: the identification thread is " + std::to_string(n) +
+                     " sample(s) behind after " + fmt("%g s", opt_.estimate_wait) +
+                     " (estimate_wait): isolation goes on with the estimate it has, so its "
+                     "results now depend on how the threads are scheduled");
+          break;
+        }
+        step_cv_.wait_until(lock, std::min(deadline, now + std::chrono::milliseconds(100)));
+      }
+    }
   }
   take_estimate();
 }
@@ -720,11 +759,14 @@ void FdiPipeline::isolation_loop() {
       } else {
         accept_rudder(std::get<RudderInput>(in));
       }
-      batch.clear();
-      assembler_.drain(&batch);
-      for (const Sample& s : batch) process(s);
-      ++inputs_handled_;
     }
+    // Also without input: a sample may have waited long enough for its rudder angle now.
+    if (assembler_.pending() > 0) {
+      batch.clear();
+      assembler_.drain(&batch, false, wall_seconds());
+      for (const Sample& s : batch) process(s);
+    }
+    if (r == BoundedQueue<Input>::PopResult::kValue) ++inputs_handled_;
     if (had_ins_ && !ins_silent_ && seconds(now - last_ins) > opt_.input_timeout) {
       ins_silent_ = true;
       log(2, fmt("no INS sample for %.2f s (input_timeout %g s): both INS channels stale",
@@ -785,13 +827,11 @@ void FdiPipeline::identification_loop() {
       }
       last_converged = e.converged;
     }
-    if (opt_.lockstep) {
-      {
-        std::lock_guard<std::mutex> lock(step_m_);
-        ++ident_done_;
-      }
-      step_cv_.notify_all();
+    {
+      std::lock_guard<std::mutex> lock(step_m_);
+      ++ident_done_;
     }
+    step_cv_.notify_all();
   }
 }
 

@@ -95,7 +95,13 @@ std::string Fleet::write_service_config(const std::string& name, unsigned mmsi,
   // The defaults, unless a line of `extra` gives the key (the loader refuses a key given
   // twice). Each sidecar config gets a state directory of its own (never the host's default).
   const std::pair<std::string, std::string> defaults[] = {
-      {"reliable_inputs", "true"}, {"status_rate", "5"}, {"state_dir", state_dir(name)}};
+      {"reliable_inputs", "true"},
+      {"status_rate", "5"},
+      {"state_dir", state_dir(name)},
+      // The simulator publishes 20-25 times faster than real time: a rudder sample repaired
+      // by a reliable resend (heartbeats every 100 ms) reaches a busy machine's sidecar some
+      // 0.2 s of wall time, several seconds of source time, after its INS sample.
+      {"rudder_wait", "1.0"}};
   for (const auto& [key, value] : defaults) {
     bool given = false;
     for (const auto& line : extra) given |= line.rfind(key + ":", 0) == 0;

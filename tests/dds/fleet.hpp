@@ -41,7 +41,8 @@ class Fleet {
   std::vector<std::string> dds_args() const;
 
   /// Writes the paper scenario's engine config (config/scenarios/paper.yaml) with a service
-  /// section: mmsi, reliable_inputs, status_rate 5, state_dir <dir>/state_<name> (unless
+  /// section: mmsi, reliable_inputs, status_rate 5, rudder_wait 1 s (wall time for a resent
+  /// sample), state_dir <dir>/state_<name> (unless
   /// `extra` sets it), and `extra` lines (indented 2 spaces).
   std::string write_service_config(const std::string& name, unsigned mmsi,
                                    const std::vector<std::string>& extra = {}) const;

@@ -110,10 +110,9 @@ TEST_P(RestartWithoutLoss, LatchedFaultsKeepTheirSequenceAcksWorkAndSequencesCon
   const int sig = GetParam();
   const unsigned m = sig == SIGKILL ? 257300001 : 257300002;
   const std::string ms = std::to_string(m);
-  // lockstep: the detector's results depend on the samples alone, not on how the machine
-  // schedules the identification thread (a busy machine otherwise shifts Â updates and may
-  // add a kind refinement, one more sequence)
-  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60", "lockstep: true"});
+  // The detector's results depend on the samples alone, not on how the machine schedules
+  // the identification thread (FdiPipeline::await_estimate)
+  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60"});
   const std::string state_file = f.state_dir("svc") + "/usv-fdi-" + ms + ".state.json";
   // GIVEN a sidecar that raised and cleared the gyro fault (#2, cleared, unacknowledged) and
   // raised the accelerometer fault (#1) of the paper's first 70 s
@@ -575,10 +574,10 @@ TEST(AckFlood, RefusedAcksAreCountedInBoundedLogAndDetectionIsUnchanged) {
   Fleet f;
   const unsigned m = 257300010;
   const std::string ms = std::to_string(m);
-  // lockstep: the detector's results depend on the samples alone (not on how the busy
-  // machine schedules the identification thread), so "unchanged" means: every sample
+  // The detector's results depend on the samples alone (not on how the busy machine
+  // schedules the identification thread), so "unchanged" means: every sample
   // arrived, in order, and made the same decisions
-  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60", "lockstep: true"});
+  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60"});
   ChildProcess& control = f.start("control", {"monitor", "--json", "--status"});
   ChildProcess& svc = f.start_service("svc", cfg, 1);
   // GIVEN a participant that floods the sidecar with acks it must refuse

@@ -205,7 +205,8 @@ class ServiceSecurity : public ::testing::Test {
       std::ofstream f(cfg);
       f << slurp(kSource + "/config/scenarios/paper.yaml");
       f << "\nservice:\n  mmsi: " << kMmsi
-        << "\n  reliable_inputs: true\n  status_rate: 5\n  input_timeout: 60\n";
+        << "\n  reliable_inputs: true\n  status_rate: 5\n  input_timeout: 60\n"
+        << "  rudder_wait: 1.0\n";  // wall time for a rudder sample resent (see fleet.cpp)
     }
     ChildProcess& p = start("sidecar", fleet_id("vessel"), {"run", "--config", cfg});
     EXPECT_TRUE(wait_for_log("sidecar", "waiting for INS and rudder", seconds(20)))

@@ -83,6 +83,32 @@ TEST(SampleAssembler, HoldsThenDropsALateRudder) {
   EXPECT_TRUE(std::isnan(out.back().delta));  // older than rudder_timeout: missing
 }
 
+TEST(SampleAssembler, FasterThanRealTimeARudderSampleLateByMillisecondsIsStillUsed) {
+  // GIVEN 64 Hz samples replayed 16 times faster than real time (1 ms of wall time each)
+  // whose rudder sample of t = 1.0 s arrives 10 ms after the INS samples up to t = 1.16 s
+  SampleAssembler a(0.1, 0.5, 0.1);
+  a.add_rudder({0.98, 0.0, true});
+  std::vector<Sample> out;
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 1.0 + k / 64.0;
+    a.add_ins({t, 0.0, 0.0, true, true}, 0.001 * k);
+    a.drain(&out, false, 0.001 * k);
+  }
+  // WHEN it arrives, 10 ms of wall-clock time later
+  EXPECT_TRUE(out.empty()) << "released after " << out.size() << " sample(s)";
+  a.add_rudder({1.0, 0.2, true});
+  a.drain(&out, false, 0.02);
+  // THEN the INS sample of t = 1.0 s was kept waiting for it and has its exact angle
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_DOUBLE_EQ(out[0].delta, 0.2);
+  // AND the others are held (no later rudder sample) once they waited 0.1 s of wall time
+  a.drain(&out, false, 0.05);
+  EXPECT_EQ(out.size(), 1u);
+  a.drain(&out, false, 0.2);
+  ASSERT_EQ(out.size(), 4u);  // 1/64 .. 3/64 s after it: at least 0.1 s older than the newest
+  EXPECT_DOUBLE_EQ(out.back().delta, 0.2);
+}
+
 TEST(SampleAssembler, DoesNotBridgeARudderGapLongerThanTheTimeout) {
   SampleAssembler a(0.1, 0.5);
   a.add_rudder({0.0, 0.0, true});
@@ -138,7 +164,6 @@ TEST(FdiPipeline, PaperScenarioThroughTheThreadsRaisesBothFaults) {
   Collected c;
   PipelineOptions opt;
   opt.input_capacity = 1 << 16;  // the test pushes faster than real time: no drops
-  opt.lockstep = true;
   FdiPipeline p = make(cfg, &c, opt);
   p.start();
   // WHEN every sample is pushed (rudder first or last, alternating) and the pipeline stops
@@ -219,7 +244,6 @@ TEST(FdiPipeline, TheDetectorSupervisesIdentificationAsInTheReplay) {
   PipelineOptions opt;
   opt.input_capacity = 1 << 16;
   opt.input_timeout = 1e9;  // wall-clock silence must not inject samples on a busy machine
-  opt.lockstep = true;
   FdiPipeline p = make(cfg, &c, opt);
   p.start();
   for (const SimRow& r : rows) {
@@ -255,14 +279,13 @@ std::vector<SimRow> paper_rows(const VesselModel& v, double duration) {
   return simulate(sim);
 }
 
-/// Raises (not refinements) of the pipeline fed `rows` in lock-step, with its status.
-std::vector<FaultEvent> lockstep_raises(const EngineConfig& cfg, const std::vector<SimRow>& rows,
+/// Raises (not refinements) of the pipeline fed `rows`, with its status.
+std::vector<FaultEvent> pipeline_raises(const EngineConfig& cfg, const std::vector<SimRow>& rows,
                                         PipelineStatus* status) {
   Collected c;
   PipelineOptions opt;
   opt.input_capacity = 1 << 16;
   opt.input_timeout = 1e9;
-  opt.lockstep = true;
   FdiPipeline p = make(cfg, &c, opt);
   p.start();
   for (const SimRow& r : rows) {
@@ -298,7 +321,7 @@ TEST(FdiPipelineClock, OneInsStampFarAheadIsRejectedAloneAndBothFaultsAreRaised)
   }
   // WHEN it runs through the pipeline
   PipelineStatus st;
-  const std::vector<FaultEvent> raises = lockstep_raises(paper_config(v), rows, &st);
+  const std::vector<FaultEvent> raises = pipeline_raises(paper_config(v), rows, &st);
   // THEN both faults are raised, and at most that sample was rejected
   EXPECT_TRUE(raised_in(raises, Sensor::kGyro, 20.0, 23.0));
   EXPECT_TRUE(raised_in(raises, Sensor::kAccelerometer, 60.0, 63.0));
@@ -313,7 +336,7 @@ TEST(FdiPipelineClock, AnInsClockRestartAtZeroIsAdoptedAndTheNextFaultsAreRaised
   for (const SimRow& r : paper_rows(v, 100.0)) rows.push_back(r);
   // WHEN it runs through the pipeline
   PipelineStatus st;
-  const std::vector<FaultEvent> raises = lockstep_raises(paper_config(v), rows, &st);
+  const std::vector<FaultEvent> raises = pipeline_raises(paper_config(v), rows, &st);
   // THEN the new time base is adopted (and counted), and both later faults are raised
   EXPECT_EQ(st.clock_resyncs, 1u);
   EXPECT_TRUE(raised_in(raises, Sensor::kGyro, 20.0, 23.0));
@@ -727,7 +750,6 @@ TEST(FdiPipelineRestore, RestoredResidualFaultIsClearedOnceTheReArmedDetectorSee
   Collected c;
   PipelineOptions opt;
   opt.input_capacity = 1 << 16;
-  opt.lockstep = true;
   opt.restore_recheck = 2.0;
   FdiPipeline p = make(cfg, &c, opt);
   FaultEvent e;

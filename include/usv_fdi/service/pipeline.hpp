@@ -58,18 +58,23 @@ struct AckInput {
 /// Pairs INS samples with the rudder angle at the same source time: linear interpolation
 /// between the rudder samples around it when both are within rudder_timeout (a longer gap
 /// is not bridged: the near side is held, else nothing); when no later rudder sample
-/// arrives within rudder_wait (source time), the last one is held if it is younger than
-/// rudder_timeout, else delta is missing (NaN) and the FDI pauses. INS samples are
-/// re-ordered by stamp inside the wait; samples with a non-finite stamp are ignored (the
-/// pipeline counts them before).
+/// arrives within rudder_wait, both of source time and of wall-clock time since the INS
+/// sample arrived (a replay faster than real time leaves little wall time between stamps,
+/// and a rudder sample a few milliseconds late in the network must not be taken for a
+/// missing one), the last one is held if it is younger than rudder_timeout, else delta is
+/// missing (NaN) and the FDI pauses. INS samples are re-ordered by stamp inside the wait;
+/// samples with a non-finite stamp are ignored (the pipeline counts them before).
 class SampleAssembler {
  public:
-  SampleAssembler(double rudder_wait, double rudder_timeout)
-      : wait_(rudder_wait), timeout_(rudder_timeout) {}
-  void add_ins(const InsInput& s);
+  /// wall_wait: the wall-clock part of the wait [s] (0: source time only).
+  SampleAssembler(double rudder_wait, double rudder_timeout, double wall_wait = 0.0)
+      : wait_(rudder_wait), timeout_(rudder_timeout), wall_wait_(wall_wait) {}
+  /// arrival: when the sample arrived, on any monotonic wall clock [s].
+  void add_ins(const InsInput& s, double arrival = 0.0);
   void add_rudder(const RudderInput& s);
-  /// Appends the samples that are ready; flush = true releases everything.
-  void drain(std::vector<Sample>* out, bool flush = false);
+  /// Appends the samples that are ready at wall-clock time `now` (the clock of add_ins);
+  /// flush = true releases everything.
+  void drain(std::vector<Sample>* out, bool flush = false, double now = 0.0);
   std::size_t pending() const { return ins_.size(); }
   /// The engine's time base is now at t (it re-synchronised, or rejected a stamp): samples
   /// more than span away from it are dropped, so that they neither hold the others back
@@ -77,9 +82,13 @@ class SampleAssembler {
   void rebase(double t, double span);
 
  private:
+  struct PendingIns {
+    InsInput s;
+    double arrival;
+  };
   double delta_at(double t) const;
-  double wait_, timeout_;
-  std::deque<InsInput> ins_;        ///< sorted by stamp
+  double wait_, timeout_, wall_wait_;
+  std::deque<PendingIns> ins_;      ///< sorted by stamp
   std::deque<RudderInput> rudder_;  ///< valid rudder samples, sorted by stamp
   double newest_ins_ = -1e300;
 };
@@ -89,7 +98,7 @@ struct PipelineOptions {
   std::size_t ack_capacity = 64;       ///< listener -> isolation thread (acks; oldest dropped)
   std::size_t ident_capacity = 16384;  ///< isolation -> identification thread
   std::size_t output_capacity = 4096;  ///< isolation -> publisher thread
-  double rudder_wait = 0.1;            ///< [s, source time]
+  double rudder_wait = 0.1;            ///< [s, source time and wall clock]
   double rudder_timeout = 0.5;         ///< [s, source time]
   double input_timeout = 1.0;          ///< INS silent this long (wall clock): stale [s]
   double status_period = 1.0;          ///< FdiStatus period (wall clock) [s]
@@ -100,9 +109,14 @@ struct PipelineOptions {
   /// stop(): events and status still queued for the sink are handed over for at most this
   /// long (wall clock); what is left after it is dropped and counted (dropped_output) [s].
   double stop_drain_timeout = 0.5;
-  /// Blocking mode: the isolation thread waits for the identification thread after each
-  /// sample, so results do not depend on scheduling (replay at full speed, tests).
-  bool lockstep = false;
+  /// Before each sample the isolation thread takes the estimate that the identification
+  /// thread made from all the earlier samples, as the offline replay does (FdiEngine): the
+  /// results depend on the samples alone, never on how the threads are scheduled. Waiting
+  /// for it takes no time when samples arrive at their rate (identification needs about a
+  /// microsecond per sample); it is bounded by this wall-clock time, after which isolation
+  /// goes on with the estimate it has, logs that the identification thread lags behind, and
+  /// waits again once it has caught up [s].
+  double estimate_wait = 5.0;
   /// Operators allowed to acknowledge (empty: anyone who can write the ack topic).
   std::vector<std::string> authorised_operators;
   /// Refused acks are logged in full 5 times per this period (wall clock) [s] at most, the
@@ -298,6 +312,11 @@ class FdiPipeline {
   void accept_rudder(const RudderInput& in);
   void process(const Sample& s);
   /// Installs the identification thread's latest estimate, if there is a new one.
+  /// Waits (bounded by estimate_wait) until the identification thread has handled every
+  /// sample handed to it, then installs its estimate.
+  void await_estimate();
+  /// Wall-clock seconds since start() (steady clock).
+  double wall_seconds() const;
   void take_estimate();
   void recheck_restored(const Sample& s);
   /// Hands an event of this run (stamped with its incarnation) to the output queue;
@@ -376,10 +395,12 @@ class FdiPipeline {
 
   std::atomic<std::uint64_t> samples_{0}, rejected_{0};
   std::atomic<std::uint64_t> inputs_handled_{0}, events_emitted_{0};
-  // Lockstep bookkeeping, under step_m_.
+  // Estimate hand-over: samples handed to the identification thread (isolation thread only)
+  // and handled by it (under step_m_); ident_lagging_: the last wait timed out (isolation).
   std::mutex step_m_;
   std::condition_variable step_cv_;
   std::uint64_t ident_pushed_ = 0, ident_done_ = 0;
+  bool ident_lagging_ = false;
   std::atomic<bool> ins_silent_{false};
   // Liveness (steady_clock ns): each thread's last loop, the last INS / rudder arrival.
   std::atomic<std::int64_t> beat_iso_{0}, beat_ident_{0}, beat_pub_{0};
