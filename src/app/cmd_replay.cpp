@@ -42,6 +42,12 @@ std::string output_conflict(const ReplayArgs& a) {
 
 /// Warns about rejected rows; an error (kExitRejected) when they are most of the input.
 int report_rejections(const std::string& file, const io::RunSummary& sum) {
+  if (sum.duplicates > 0) {
+    spdlog::warn(
+        "{}: {} of {} rows repeat the previous row exactly (a sample recorded twice): dropped; "
+        "the first: {}:{}",
+        file, sum.duplicates, sum.samples, file, sum.first_duplicate_line);
+  }
   if (sum.rejected == 0) return kExitOk;
   std::string first = fmt::format("{}:{}", file, sum.first_rejected_line);
   if (std::isfinite(sum.first_rejected_t)) {

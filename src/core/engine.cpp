@@ -100,9 +100,22 @@ void IsolationStage::restart(const Sample& s) {
   estimate_.t = s.t;
 }
 
+namespace {
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+}  // namespace
+
 bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
                              IdentificationInput* handover) {
   detections_.clear();
+  // One sample delivered twice is dropped; a third copy is a clock that stands still.
+  last_duplicate_ = !repeated_ && std::isfinite(s.t) && s.t == last_accepted_.t &&
+                    same(s.v, last_accepted_.v) && same(s.r, last_accepted_.r) &&
+                    same(s.delta, last_accepted_.delta);
+  if (last_duplicate_) {
+    ++duplicates_;
+    repeated_ = true;
+    return false;
+  }
   SampleClock::Verdict verdict = SampleClock::Verdict::kAccept;
   if (std::isfinite(s.t)) verdict = clock_.check(s.t);
   if (verdict == SampleClock::Verdict::kResync) restart(s);
@@ -116,6 +129,8 @@ bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
     if (apply(d, &ev)) events->push_back(ev);
   }
   if (!accepted) return false;
+  last_accepted_ = s;
+  repeated_ = false;
   const IsolatorStatus& st = iso_.status();
   handover->sample = s;
   handover->freeze = iso_.freeze_requested();

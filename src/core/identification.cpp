@@ -645,6 +645,7 @@ void Identifier::update_std_error() {
   for (int i = 0; i < 2; ++i) {
     const Mat2 C = Pinv * (R[i] * (dof * mem_.W2 / T)) * Pinv.transpose();
     for (int j = 0; j < 2; ++j) est_.std_error(2 * i + j) = std::sqrt(std::max(0.0, C(j, j)));
+    row_cov_[i] = C;
   }
 }
 
@@ -672,10 +673,46 @@ double Identifier::relative_std_error(const Vec4& a) const {
   const double k = std::max(1.0, std_error_dof_);
   const double c = 2.0 / (9.0 * k);
   const double q = k * std::pow(std::max(1e-3, 1.0 - c - 1.2816 * std::sqrt(c)), 3.0);
-  const double upper = std::sqrt(k / q);
+  const double upper2 = k / q;
   double worst = 0.0;
-  for (int n = 0; n < 4; ++n) {
-    const double r = upper * est_.std_error(n) / std::max(std::abs(a(n)), p_.settle_floor);
+  if (p_.precision == Precision::kCoefficients) {
+    for (int n = 0; n < 4; ++n) {
+      const double r =
+          std::sqrt(upper2) * est_.std_error(n) / std::max(std::abs(a(n)), p_.settle_floor);
+      worst = std::isnan(r) ? std::numeric_limits<double>::infinity() : std::max(worst, r);
+    }
+    return worst;
+  }
+  for (int i = 0; i < 2; ++i) {
+    // E[(da_i^T q)^2] = tr(Cov_i Q) over the memory (Q: its sum of q q^T).
+    const double err = std::sqrt(upper2 * (row_cov_[i] * mem_.Pqq).trace());
+    const double r = err / prediction_scale(a, i);
+    worst = std::isnan(r) ? std::numeric_limits<double>::infinity() : std::max(worst, r);
+  }
+  return worst;
+}
+
+double Identifier::prediction_scale(const Vec4& a, int i) const {
+  // The RMS of each term a_ij q_j, added: the terms of a_i^T q may cancel (in a steady turn
+  // A x = -B delta), and a relative error must not grow with that cancellation.
+  const Mat2& Q = mem_.Pqq;
+  const double floor = p_.settle_floor * std::sqrt(Q.trace());
+  const double s = std::abs(a(2 * i)) * std::sqrt(std::max(0.0, Q(0, 0))) +
+                   std::abs(a(2 * i + 1)) * std::sqrt(std::max(0.0, Q(1, 1)));
+  return std::max(s, floor);
+}
+
+double Identifier::relative_prediction_change(const Vec4& d, const Vec4& a) const {
+  double worst = 0.0;
+  if (p_.precision == Precision::kCoefficients) {
+    for (int n = 0; n < 4; ++n) {
+      worst = std::max(worst, std::abs(d(n)) / (std::abs(a(n)) + p_.settle_floor));
+    }
+    return worst;
+  }
+  for (int i = 0; i < 2; ++i) {
+    const Vec2 di(d(2 * i), d(2 * i + 1));
+    const double r = std::sqrt(std::max(0.0, di.dot(mem_.Pqq * di))) / prediction_scale(a, i);
     worst = std::isnan(r) ? std::numeric_limits<double>::infinity() : std::max(worst, r);
   }
   return worst;
@@ -688,23 +725,23 @@ void Identifier::update_convergence(double t) {
     return;
   }
   if (t - t_ref_ < p_.settle_window) return;
-  double d = 0.0;
-  for (int n = 0; n < 4; ++n) {
-    d = std::max(d, std::abs(a_(n) - a_ref_(n)) / (std::abs(a_(n)) + p_.settle_floor));
-  }
+  // How much the last window's change of A moved the model's prediction (relative).
+  const double d = relative_prediction_change(a_ - a_ref_, a_);
   est_.settling = d;
   bool precise = true;
   if (p_.method == IdentMethod::kKreisselmeier) {
     // The standard errors come from few batches at first, so their own uncertainty counts:
     // the test uses their upper 90 % confidence bound, se sqrt(k / chi2_k(0.1)), k = batches
     // - 2 degrees of freedom (Wilson-Hilferty for the quantile). NaN (too few batches) fails.
-    precise = relative_std_error(a_) <= p_.max_std_error;
+    est_.uncertainty = relative_std_error(a_);
+    precise = est_.uncertainty <=
+              (p_.precision == Precision::kPrediction ? p_.max_prediction_error : p_.max_std_error);
   }
   // Nothing converges on data the guard keeps out, nor while it keeps data out, nor before
   // it can judge (with the guard on).
+  const bool guarded = p_.guard && p_.method == IdentMethod::kKreisselmeier;
   const bool consistent =
-      est_.consistent && inconsistent_run_ == 0.0 &&
-      (!p_.guard || p_.method != IdentMethod::kKreisselmeier || accepted_windows() >= kMinJudge);
+      est_.consistent && inconsistent_run_ == 0.0 && (!guarded || accepted_windows() >= kMinJudge);
   const bool excited = est_.excitation >= p_.min_excitation &&
                        est_.time_constant <= p_.settle_window * p_.settle_windows;
   settled_count_ =

@@ -99,6 +99,10 @@ void IsolationParams::validate() const {
   require(stale_timeout > 0, "stale_timeout", stale_timeout, "must be > 0");
   require(stuck_time > 0, "stuck_time", stuck_time, "must be > 0");
   require(stuck_min_samples >= 2, "stuck_min_samples", stuck_min_samples, "must be >= 2");
+  require(stuck_probability > 0 && stuck_probability < 1, "stuck_probability", stuck_probability,
+          "must lie in (0, 1)");
+  require(stuck_learn_time > 0, "stuck_learn_time", stuck_learn_time, "must be > 0");
+  require(stuck_time_max >= stuck_time, "stuck_time_max", stuck_time_max, "must be >= stuck_time");
   require(max_abs_v > 0, "max_abs_v", max_abs_v, "must be > 0");
   require(max_abs_r > 0, "max_abs_r", max_abs_r, "must be > 0");
   require(max_abs_delta > 0, "max_abs_delta", max_abs_delta, "must be > 0");
@@ -350,19 +354,35 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
     prune(&ch.invalids, s.t - p_.spike_window);
     const bool valid = !missing && !absurd;
     if (valid) {
-      if (x == ch.last_value) {
+      const bool repeat = x == ch.last_value;
+      if (repeat) {
         if (ch.stuck_samples == 0) ch.stuck_since = ch.last_valid_t;
         ++ch.stuck_samples;
       } else {
         ch.stuck_samples = 0;
         ch.stuck_since = kNaN;
       }
+      // How often this channel repeats a value while it moves (its quantisation), learned
+      // while it is not taken for stuck.
+      if (!(c < 2 && (cond_[c].sources & kStuck)) && std::isfinite(ch.last_value)) {
+        // The mean of the first samples, then an exponential average over stuck_learn_time.
+        ch.repeat_seen += 1.0;
+        const double w = std::max(1.0 / ch.repeat_seen,
+                                  std::min(1.0, (s.t - ch.last_valid_t) / p_.stuck_learn_time));
+        ch.repeat_fraction += w * ((repeat ? 1.0 : 0.0) - ch.repeat_fraction);
+      }
       ch.last_value = x;
       ch.last_valid_t = s.t;
     }
     const bool stale = s.t - ch.last_valid_t > p_.stale_timeout;
-    const bool stuck =
-        ch.stuck_samples + 1 >= p_.stuck_min_samples && s.t - ch.stuck_since >= p_.stuck_time;
+    const double held = s.t - ch.stuck_since;  // NaN while the value moves
+    bool stuck = false;
+    if (ch.stuck_samples + 1 >= p_.stuck_min_samples && held >= p_.stuck_time) {
+      // Repeats needed: a run this long is improbable for the channel as learned.
+      const double f = std::min(ch.repeat_fraction, 1.0 - 1e-12);
+      const double needed = f > 0.0 ? std::log(p_.stuck_probability) / std::log(f) : 0.0;
+      stuck = ch.stuck_samples >= needed || held >= p_.stuck_time_max;
+    }
     const bool invalid = static_cast<int>(ch.invalids.size()) >= p_.invalid_count;
     ok[c] = !stale && !invalid;
     if (c == 2) continue;  // the rudder is not an INS sensor: it pauses FDI (status flag)

@@ -108,7 +108,11 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   if (!in.r_ok) msg += "gyro channel unusable; ";
   if (!s.isolation.observer_problem.empty()) msg += s.isolation.observer_problem + "; ";
   if (!s.isolation.armed) {
-    msg += s.estimate.converged ? "converged, arming; " : "identifying A; ";
+    // Why A has not converged, in words ("identifying A: excitation too low").
+    std::string why = to_string(s.estimate.status);
+    const std::string prefix = "not converged: ";
+    if (why.rfind(prefix, 0) == 0) why = why.substr(prefix.size());
+    msg += s.estimate.converged ? "converged, arming; " : "identifying A: " + why + "; ";
   } else if (s.isolation.learning || s.isolation.settling) {
     msg += "armed, learning healthy statistics; ";
   } else {

@@ -234,6 +234,17 @@ class Loader {
              fail(n, p, "expected rudder or regressor");
            }
          }},
+        {"precision",
+         [&](const YAML::Node& n, const std::string& p) {
+           const std::string m = text(n, p);
+           if (m == "coefficients") {
+             id.precision = Precision::kCoefficients;
+           } else if (m == "prediction") {
+             id.precision = Precision::kPrediction;
+           } else {
+             fail(n, p, "expected coefficients or prediction");
+           }
+         }},
         {"eps1", num(&id.eps1, {1e-3, 1e3, "1/s"})},
         {"eps2", num(&id.eps2, {1e-3, 1e3, "1/s"})},
         {"gamma", num(&id.gamma, {0, 1e15, "1/s (paper law: 1/(psi^2 s))"})},
@@ -250,6 +261,7 @@ class Loader {
         {"settle_windows", integ(&id.settle_windows, {1, 1000, ""})},
         {"settle_floor", num(&id.settle_floor, {0, 1e3, "(unit of a_n)"})},
         {"max_std_error", num(&id.max_std_error, {0, 10, ""})},
+        {"max_prediction_error", num(&id.max_prediction_error, {0, 10, ""})},
         {"guard", boo(&id.guard)},
         {"guard_threshold", num(&id.guard_threshold, {0, 1e6, ""})},
         {"guard_min_shift", num(&id.guard_min_shift, {0, 10, ""})},
@@ -286,6 +298,9 @@ class Loader {
         {"stale_timeout", num(&is.stale_timeout, {0, kHour, "s"})},
         {"stuck_time", num(&is.stuck_time, {0, kHour, "s"})},
         {"stuck_min_samples", integ(&is.stuck_min_samples, {1, 1000000, ""})},
+        {"stuck_probability", num(&is.stuck_probability, {0, 1, ""})},
+        {"stuck_learn_time", num(&is.stuck_learn_time, {0, 1e6, "s"})},
+        {"stuck_time_max", num(&is.stuck_time_max, {0, kHour, "s"})},
         {"max_abs_v", num(&is.max_abs_v, {0, 1e3, "m/s"})},
         {"max_abs_r", num(&is.max_abs_r, {0, 100, "rad/s"})},
         {"max_abs_delta", num(&is.max_abs_delta, {0, 6.3, "rad"})},

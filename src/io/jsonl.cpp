@@ -134,15 +134,18 @@ void JsonlWriter::estimate(double t, const Estimate& est, bool armed) {
   out_ << "{\"type\":\"estimate\",\"t\":" << json_number(t) << ",\"a\":" << array4(to_params(est.A))
        << ",\"converged\":" << boolean(est.converged)
        << ",\"excitation\":" << json_number(est.excitation) << ",\"armed\":" << boolean(armed)
-       << "}\n";
+       << ",\"status\":" << json_string(to_string(est.status))
+       << ",\"settling\":" << json_number(est.settling)
+       << ",\"uncertainty\":" << json_number(est.uncertainty)
+       << ",\"std_error\":" << array4(est.std_error) << "}\n";
 }
 
 void JsonlWriter::summary(const RunSummary& s) {
   out_ << "{\"type\":\"summary\",\"samples\":" << s.samples << ",\"rejected\":" << s.rejected
-       << ",\"events\":" << s.events << ",\"raised\":{\"accelerometer\":" << s.raised[0]
-       << ",\"gyro\":" << s.raised[1] << ",\"unknown\":" << s.raised[2]
-       << "},\"final_a\":" << array4(s.final_a) << ",\"converged\":" << boolean(s.converged)
-       << ",\"frozen_samples\":" << s.frozen_samples
+       << ",\"duplicates\":" << s.duplicates << ",\"events\":" << s.events
+       << ",\"raised\":{\"accelerometer\":" << s.raised[0] << ",\"gyro\":" << s.raised[1]
+       << ",\"unknown\":" << s.raised[2] << "},\"final_a\":" << array4(s.final_a)
+       << ",\"converged\":" << boolean(s.converged) << ",\"frozen_samples\":" << s.frozen_samples
        << ",\"duration_s\":" << json_number(s.duration_s)
        << ",\"complete\":" << boolean(s.complete);
   if (!s.complete) out_ << ",\"error\":" << json_string(s.error);

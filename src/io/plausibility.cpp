@@ -126,27 +126,19 @@ std::string convergence_report(const Estimate& est, const IdentificationParams& 
                100.0 * est.settling, 100.0 * p.settle_tolerance));
   }
   if (p.method == IdentMethod::kKreisselmeier) {
-    double worst = 0.0;
-    int worst_n = -1;
-    for (int n = 0; n < 4; ++n) {
-      const double rel = est.std_error(n) / std::max(std::abs(to_params(est.A)(n)), p.settle_floor);
-      if (std::isnan(rel)) {
-        worst_n = -2;
-        break;
-      }
-      if (rel > worst) {
-        worst = rel;
-        worst_n = n;
-      }
-    }
-    if (worst_n == -2) {
+    const bool prediction = p.precision == Precision::kPrediction;
+    const double limit = prediction ? p.max_prediction_error : p.max_std_error;
+    if (!std::isfinite(est.uncertainty)) {
       why.push_back("standard errors not known yet (fewer than three batches of data)");
-    } else if (worst > p.max_std_error || est.status == IdentStatus::kImprecise) {
-      why.push_back(
-          format("the largest standard error, of a%.0f, is %.3g %% of its value (its "
-                 "upper 90 %% confidence bound must be below identification."
-                 "max_std_error = %g %%)",
-                 worst_n + 1.0, 100.0 * worst, 100.0 * p.max_std_error));
+    } else if (est.uncertainty > limit || est.status == IdentStatus::kImprecise) {
+      why.push_back(format(prediction
+                               ? "the standard errors of A allow an error of %.3g %% in the "
+                                 "model's prediction (its upper 90 %% confidence bound must be "
+                                 "below identification.max_prediction_error = %g %%)"
+                               : "the largest standard error of an a_n is %.3g %% of its value "
+                                 "(its upper 90 %% confidence bound must be below "
+                                 "identification.max_std_error = %g %%)",
+                           100.0 * est.uncertainty, 100.0 * limit));
     }
   }
   if (!est.consistent || est.inconsistent_time > 0.0) {

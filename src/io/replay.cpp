@@ -46,7 +46,11 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
       ++sum.samples;
       plausible.add(s);
       events.clear();
-      if (!engine.process(s, &events)) {
+      const bool accepted = engine.process(s, &events);
+      if (!accepted && engine.last_was_duplicate()) {
+        ++sum.duplicates;  // the previous row once more: dropped, not an error
+        if (sum.first_duplicate_line == 0) sum.first_duplicate_line = input.line();
+      } else if (!accepted) {
         ++sum.rejected;
         if (!std::isfinite(s.t)) ++sum.rejected_no_time;
         if (sum.first_rejected_line == 0) {

@@ -323,6 +323,10 @@ void FdiPipeline::process(const Sample& s) {
                "consistently from t=%.3f s: detection and identification restarted",
                iso_.clock().resync_from(), s.t));
   }
+  if (!ok && iso_.last_was_duplicate()) {
+    ++duplicates_;  // the previous sample once more (a source or link repeated it): dropped
+    return;
+  }
   if (!ok || resynced) {
     assembler_.rebase(iso_.clock().last(), cfg_.clock_max_jump);
   }
@@ -568,6 +572,7 @@ PipelineStatus FdiPipeline::make_status() {
   st.isolation = iso_.status();
   st.samples = samples_.load();
   st.rejected = rejected_.load();
+  st.duplicates = duplicates_.load();
   st.clock_resyncs = iso_.clock().resyncs();
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();
@@ -670,6 +675,12 @@ void FdiPipeline::log_input_changes(const PipelineStatus& st) {
                std::to_string(st.lost_ins) + " INS and " + std::to_string(st.lost_rudder) +
                " rudder since start)");
   }
+  if (st.duplicates > logged_.duplicates) {
+    log(1, "inputs: " + more(st.duplicates, logged_.duplicates) +
+               " exact repeat(s) of the previous INS sample dropped (" +
+               std::to_string(st.duplicates) + " since start)");
+  }
+  logged_.duplicates = st.duplicates;
   const std::uint64_t restarts = ins_seq_.restarts() + rudder_seq_.restarts();
   if (restarts > logged_.seq_restarts) {
     log(1,

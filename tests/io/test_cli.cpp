@@ -265,7 +265,7 @@ TEST_F(Cli, ReplayOfMostlyRejectedRowsExitsWith5) {
   ASSERT_FALSE(recs.empty());
   EXPECT_EQ(recs.back().at("rejected").num, 250.0);
 
-  // Three repeated rows: a warning, exit 0.
+  // Three rows recorded twice: a warning, exit 0 (dropped as duplicates, not rejected).
   spit(path("dup.csv"), with_times(csv, 0, 0, "", {100, 200, 250}));
   r = run("replay --config '" + cfg + "' --input '" + path("dup.csv") + "' --output '" + jsonl +
           "'");

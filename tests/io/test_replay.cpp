@@ -237,14 +237,17 @@ TEST(Replay, CountsAndLocatesRejectedRows) {
       "t,v,r,delta\n"
       "0,0,0,0\n"
       "0.1,0,0,0\n"
-      "0.1,0,0,0\n"   // line 4: repeats
-      "nan,0,0,0\n"   // line 5: no time
-      "0.05,0,0,0\n"  // line 6: goes back
-      "0.2,0,0,0\n";
+      "0.1,0.01,0,0\n"  // line 4: repeats the time, with another value
+      "nan,0,0,0\n"     // line 5: no time
+      "0.05,0,0,0\n"    // line 6: goes back
+      "0.2,0,0,0\n"
+      "0.2,0,0,0\n";  // line 8: the previous row once more (dropped, not rejected)
   RunSummary sum;
   replay_text(quick_config(), csv, &sum);
-  EXPECT_EQ(sum.samples, 6u);
+  EXPECT_EQ(sum.samples, 7u);
   EXPECT_EQ(sum.rejected, 3u);
+  EXPECT_EQ(sum.duplicates, 1u);
+  EXPECT_EQ(sum.first_duplicate_line, 8u);
   EXPECT_EQ(sum.rejected_no_time, 1u);
   EXPECT_EQ(sum.first_rejected_line, 4u);
   EXPECT_EQ(sum.first_rejected_t, 0.1);

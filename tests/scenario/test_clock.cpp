@@ -2,6 +2,7 @@
 // detection (issue 15, item 2). Shipped configuration of the golden fault voyage.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,7 @@ std::vector<SimRow> voyage(double duration, std::uint64_t seed, bool with_faults
 
 struct Outcome {
   std::vector<FaultEvent> raises;
-  std::uint64_t rejected = 0, resyncs = 0;
+  std::uint64_t rejected = 0, resyncs = 0, duplicates = 0;
 };
 
 Outcome replay(const std::vector<Sample>& samples) {
@@ -50,6 +51,7 @@ Outcome replay(const std::vector<Sample>& samples) {
   }
   out.rejected = engine.rejected_samples();
   out.resyncs = engine.clock_resyncs();
+  out.duplicates = engine.duplicate_samples();
   return out;
 }
 
@@ -95,15 +97,67 @@ TEST(SourceClock, AnInsClockRestartingAtZeroIsAdoptedAndTheNextVoyagesFaultsAreR
   }
 }
 
+TEST(SourceClock, SamplesDeliveredTwiceAreDroppedAndCountedNotTakenForTimingErrors) {
+  // GIVEN the faults voyage in which every 20th sample is delivered twice, in bursts of
+  // three within 2 s (three timing errors within spike_window would raise a timing fault)
+  std::vector<Sample> samples;
+  std::uint64_t twice = 0;
+  for (const SimRow& r : voyage(200.0, 2, true)) {
+    samples.push_back({r.t, r.v, r.r, r.delta});
+    const long k = std::lround(r.t * 10.0);
+    if (k % 20 == 0 || k % 20 == 7 || k % 20 == 14) {
+      samples.push_back(samples.back());
+      ++twice;
+    }
+  }
+  // WHEN it is replayed
+  const Outcome o = replay(samples);
+  // THEN every repeat is dropped and counted as a duplicate, none is rejected, and only the
+  // voyage's own faults are raised (no timing fault on "unknown")
+  EXPECT_EQ(o.duplicates, twice);
+  EXPECT_EQ(o.rejected, 0u);
+  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0));
+  for (const FaultEvent& e : o.raises) {
+    EXPECT_NE(e.sensor, Sensor::kUnknown) << to_string(e.kind) << " at " << e.t;
+  }
+}
+
+TEST(SourceClock, RepeatedStampsWithOtherValuesAreStillTimingErrors) {
+  // GIVEN the healthy voyage in which three samples within 2 s repeat the previous stamp
+  // with other values (a clock that did not advance, not a sample delivered twice)
+  std::vector<Sample> samples;
+  for (const SimRow& r : voyage(200.0, 2, false)) {
+    samples.push_back({r.t, r.v, r.r, r.delta});
+    const long k = std::lround(r.t * 10.0);
+    if (k == 1200 || k == 1205 || k == 1210) {
+      Sample again = samples.back();
+      again.v += 0.01;
+      samples.push_back(again);
+    }
+  }
+  // WHEN it is replayed
+  const Outcome o = replay(samples);
+  // THEN they are rejected and the timing fault ("unknown", invalid) is raised
+  EXPECT_EQ(o.rejected, 3u);
+  EXPECT_EQ(o.duplicates, 0u);
+  bool timing = false;
+  for (const FaultEvent& e : o.raises) {
+    timing |= e.sensor == Sensor::kUnknown && e.kind == FaultKind::kInvalid;
+  }
+  EXPECT_TRUE(timing);
+}
+
 TEST(SourceClock, AClockThatStandsStillIsRejectedSampleBySampleAndCounted) {
   // GIVEN a stream whose stamp stops advancing for a million samples
   FdiEngine engine(io::load_engine_config(kSource + "/tests/golden/faults_otter.yaml"));
   std::vector<FaultEvent> events;
   for (int k = 0; k < 100; ++k) engine.process({0.1 * k, 0.0, 0.0, 0.0}, &events);
   for (int k = 0; k < 1000000; ++k) engine.process({9.9, 0.0, 0.0, 0.0}, &events);
-  // THEN every one is rejected and counted, and the timing fault is raised once
-  EXPECT_EQ(engine.rejected_samples(), 1000000u);
-  EXPECT_EQ(engine.isolation_status().input.rejected_time, 1000000u);
+  // THEN the first is taken for a sample delivered twice (dropped, counted as a duplicate),
+  // every later one is rejected and counted, and the timing fault is raised once
+  EXPECT_EQ(engine.duplicate_samples(), 1u);
+  EXPECT_EQ(engine.rejected_samples(), 999999u);
+  EXPECT_EQ(engine.isolation_status().input.rejected_time, 999999u);
   EXPECT_EQ(engine.clock_resyncs(), 0u);
 }
 

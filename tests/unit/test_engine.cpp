@@ -40,5 +40,70 @@ TEST(IsolatorInputs, RepeatedTimestampsNeverMakeTheRudderMissing) {
   }
 }
 
+/// x printed with 3 significant digits (as an NMEA field or a CSV of a logger may be).
+double three_digits(double x) {
+  if (x == 0.0) return 0.0;
+  const double e = std::pow(10.0, std::floor(std::log10(std::abs(x))) - 2.0);
+  return std::round(x / e) * e;
+}
+
+bool stuck_raised(const std::vector<Detection>& out, Sensor s, bool active) {
+  for (const Detection& d : out) {
+    if (d.sensor == s && d.kind == FaultKind::kStuck && d.active == active) return true;
+  }
+  return false;
+}
+
+TEST(IsolatorInputs, AQuantisedMovingChannelIsNotStuckAndAFrozenOneStillIs) {
+  // GIVEN 50 Hz samples whose sway velocity, about 1.2 m/s in a turn and moving by about
+  // 0.01 m/s, is printed with 3 significant digits: 0.01 m/s steps, so a value often repeats
+  // for many samples
+  Isolator iso(IsolationParams{}, Vec2(0.01, 0.002));
+  std::vector<Detection> out;
+  double t = 0.0;
+  const auto sample = [&](double at) {
+    Sample s = moving(at);
+    s.v = three_digits(1.2 + 0.01 * std::sin(0.3 * at) + 0.005 * std::sin(7.1 * at));
+    return s;
+  };
+  // WHEN 10 minutes of it pass
+  for (; t < 600.0; t += 0.02) ASSERT_TRUE(iso.update(sample(t), &out));
+  // THEN the accelerometer channel is never taken for stuck
+  EXPECT_FALSE(stuck_raised(out, Sensor::kAccelerometer, true));
+  EXPECT_TRUE(iso.status().input.v_ok);
+  // WHEN it then freezes at its last value
+  const double v_frozen = sample(t).v;
+  const double t_freeze = t;
+  out.clear();
+  for (; t < t_freeze + 10.0; t += 0.02) {
+    Sample s = sample(t);
+    s.v = v_frozen;
+    ASSERT_TRUE(iso.update(s, &out));
+    if (stuck_raised(out, Sensor::kAccelerometer, true)) break;
+  }
+  // THEN it is caught within stuck_time_max
+  EXPECT_TRUE(stuck_raised(out, Sensor::kAccelerometer, true));
+  EXPECT_LE(t - t_freeze, IsolationParams{}.stuck_time_max + 0.05);
+}
+
+TEST(IsolatorInputs, AFullPrecisionChannelThatFreezesIsStuckAfterStuckTime) {
+  // GIVEN a channel that has never repeated a value (nothing learned)
+  Isolator iso(IsolationParams{}, Vec2(0.01, 0.002));
+  std::vector<Detection> out;
+  double t = 0.0;
+  for (; t < 60.0; t += 0.02) ASSERT_TRUE(iso.update(moving(t), &out));
+  // WHEN its gyro value freezes
+  const double r = moving(t).r, t_freeze = t;
+  out.clear();
+  for (; t < t_freeze + 2.0 && !stuck_raised(out, Sensor::kGyro, true); t += 0.02) {
+    Sample s = moving(t);
+    s.r = r;
+    ASSERT_TRUE(iso.update(s, &out));
+  }
+  // THEN stuck is raised after stuck_time, as without the learning
+  EXPECT_TRUE(stuck_raised(out, Sensor::kGyro, true));
+  EXPECT_LE(t - t_freeze, IsolationParams{}.stuck_time + 0.1);
+}
+
 }  // namespace
 }  // namespace usvfdi

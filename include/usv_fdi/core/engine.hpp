@@ -133,6 +133,12 @@ class IsolationStage {
   const SampleClock& clock() const { return clock_; }
   /// Samples rejected for their stamp (not finite, or outside the time base).
   std::uint64_t rejected_samples() const { return rejected_; }
+  /// Exact repeats of the previous accepted sample (same stamp, same values): a source or a
+  /// link that delivered one sample twice. Dropped and counted; not a timing error (a
+  /// second repeat of the same sample is: the source's clock stands still).
+  std::uint64_t duplicate_samples() const { return duplicates_; }
+  /// The last process() call dropped its sample as a duplicate.
+  bool last_was_duplicate() const { return last_duplicate_; }
 
  private:
   /// A new time base: the detector starts afresh (its windows, observers and learned
@@ -143,6 +149,10 @@ class IsolationStage {
   Vec2 B_;
   SampleClock clock_;
   std::uint64_t rejected_ = 0;
+  std::uint64_t duplicates_ = 0;
+  bool last_duplicate_ = false;
+  bool repeated_ = false;  ///< last_accepted_ was repeated once already
+  Sample last_accepted_{kNaN, kNaN, kNaN, kNaN};
   Isolator iso_;
   Estimate estimate_;  ///< in force (its A goes into every event)
   std::array<FaultLatch, 3> latches_{FaultLatch(Sensor::kAccelerometer), FaultLatch(Sensor::kGyro),
@@ -172,6 +182,9 @@ class FdiEngine {
   /// Samples rejected for their stamp, and re-synchronisations of the time base.
   std::uint64_t rejected_samples() const { return iso_.rejected_samples(); }
   std::uint64_t clock_resyncs() const { return iso_.clock().resyncs(); }
+  /// Exact repeats of the previous sample dropped (IsolationStage::duplicate_samples).
+  std::uint64_t duplicate_samples() const { return iso_.duplicate_samples(); }
+  bool last_was_duplicate() const { return iso_.last_was_duplicate(); }
 
  private:
   IsolationStage iso_;

@@ -64,17 +64,25 @@ struct IsolationParams {
   /// estimate of A in its quiet spells [s].
   double resume_after_fault = 10.0;
   // Sensor-level checks.
-  double stale_timeout = 0.5;    ///< no valid value for this long: stale [s]
-  double stuck_time = 0.5;       ///< value unchanged for this long: stuck [s]
-  int stuck_min_samples = 5;     ///< ... and for at least this many samples
-  double max_abs_v = 20.0;       ///< |v| above this is invalid [m/s]
-  double max_abs_r = 3.0;        ///< |r| above this is invalid [rad/s]
-  double max_abs_delta = 1.6;    ///< |delta| above this is invalid [rad]
-  double spike_gate = 8.0;       ///< |s_i| above this on 1-2 samples is a spike
-  double spike_window = 3.0;     ///< spikes are counted over this window [s]
-  int spike_count = 3;           ///< this many spikes in the window raise a spikes fault
-  int invalid_count = 3;         ///< this many invalid values in spike_window raise invalid
-  double classify_window = 8.0;  ///< history used to name the kind of a fault [s]
+  double stale_timeout = 0.5;  ///< no valid value for this long: stale [s]
+  double stuck_time = 0.5;     ///< value unchanged for this long: stuck [s]
+  int stuck_min_samples = 5;   ///< ... and for at least this many samples
+  /// A quantised or coarsely printed channel (a yaw rate as NMEA ROT, v to 3 significant
+  /// digits) repeats its value while it moves. The fraction f of samples that repeat the
+  /// previous one is learned (exponential average over stuck_learn_time, not while stuck),
+  /// and a channel is stuck only when its run of repeats is also longer than n samples with
+  /// f^n <= stuck_probability: improbable for the channel as it has been [-]
+  double stuck_probability = 1e-9;
+  double stuck_learn_time = 60.0;  ///< averaging time of the repeat fraction [s]
+  double stuck_time_max = 5.0;     ///< ... but unchanged this long is always stuck [s]
+  double max_abs_v = 20.0;         ///< |v| above this is invalid [m/s]
+  double max_abs_r = 3.0;          ///< |r| above this is invalid [rad/s]
+  double max_abs_delta = 1.6;      ///< |delta| above this is invalid [rad]
+  double spike_gate = 8.0;         ///< |s_i| above this on 1-2 samples is a spike
+  double spike_window = 3.0;       ///< spikes are counted over this window [s]
+  int spike_count = 3;             ///< this many spikes in the window raise a spikes fault
+  int invalid_count = 3;           ///< this many invalid values in spike_window raise invalid
+  double classify_window = 8.0;    ///< history used to name the kind of a fault [s]
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
@@ -172,8 +180,10 @@ class Isolator {
     double last_value = kNaN;
     double stuck_since = kNaN;
     int stuck_samples = 0;
-    std::deque<double> spikes;    ///< times of spikes
-    std::deque<double> invalids;  ///< times of invalid values
+    double repeat_fraction = 0.0;  ///< learned fraction of samples equal to the previous
+    double repeat_seen = 0;        ///< samples it was learned from (a plain mean at first)
+    std::deque<double> spikes;     ///< times of spikes
+    std::deque<double> invalids;   ///< times of invalid values
     int outlier_run = 0;
     bool last_ordinary = true;  ///< the previous residual was well inside the gate
     bool run_isolated = false;  ///< the current outlier run began after an ordinary sample

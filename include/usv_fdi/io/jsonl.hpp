@@ -35,7 +35,9 @@ std::string json_string_array(const std::string& names, const char* separator = 
 struct RunSummary {
   std::uint64_t samples = 0;   ///< rows read
   std::uint64_t rejected = 0;  ///< rows the engine rejected (time missing or not increasing)
-  std::uint64_t rejected_no_time = 0;  ///< of them: time missing or not finite
+  std::uint64_t rejected_no_time = 0;    ///< of them: time missing or not finite
+  std::uint64_t duplicates = 0;          ///< rows that repeat the previous one exactly (dropped)
+  std::size_t first_duplicate_line = 0;  ///< the first of them (not in the JSON record)
   // The first rejected row (not in the JSON record; for the command's message).
   std::size_t first_rejected_line = 0;           ///< its line in the input (0: none rejected)
   double first_rejected_t = kNaN;                ///< its time [s]

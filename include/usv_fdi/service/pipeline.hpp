@@ -175,6 +175,7 @@ struct PipelineStatus {
   std::uint64_t dropped_ident = 0;   ///< identification queue overflow
   std::uint64_t dropped_output = 0;  ///< output queue overflow, and events left at stop()
   std::uint64_t rejected = 0;        ///< samples the engine refused for their stamp
+  std::uint64_t duplicates = 0;      ///< exact repeats of the previous sample, dropped
   std::uint64_t clock_resyncs = 0;   ///< new time bases adopted (the engine restarted on each)
   bool ins_silent = false;           ///< no INS sample for input_timeout
   bool rudder_missing = false;       ///< the last sample had no rudder angle
@@ -297,7 +298,7 @@ class FdiPipeline {
   /// What the previous status period's log summary had seen.
   struct ProblemCounts {
     std::uint64_t rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
-                  dropped_inputs = 0, lost = 0, seq_restarts = 0;
+                  dropped_inputs = 0, lost = 0, seq_restarts = 0, duplicates = 0;
   };
 
   static std::int64_t now_ns() {
@@ -393,7 +394,7 @@ class FdiPipeline {
   std::array<FaultEvent, 3> latest_{};
   std::array<std::uint64_t, 3> published_seq_{0, 0, 0};
 
-  std::atomic<std::uint64_t> samples_{0}, rejected_{0};
+  std::atomic<std::uint64_t> samples_{0}, rejected_{0}, duplicates_{0};
   std::atomic<std::uint64_t> inputs_handled_{0}, events_emitted_{0};
   // Estimate hand-over: samples handed to the identification thread (isolation thread only)
   // and handled by it (under step_m_); ident_lagging_: the last wait timed out (isolation).
