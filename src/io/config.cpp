@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -197,6 +198,22 @@ class Loader {
       return
           [this, out, r](const YAML::Node& n, const std::string& p) { *out = vector<2>(n, p, r); };
     };
+    // One of a few names, each standing for a value ("expected a or b" otherwise).
+    auto choice = [this](auto* out,
+                         std::vector<std::pair<std::string, std::decay_t<decltype(*out)>>> names) {
+      return [this, out, names](const YAML::Node& n, const std::string& p) {
+        const std::string m = text(n, p);
+        std::string expected;
+        for (std::size_t i = 0; i < names.size(); ++i) {
+          if (names[i].first == m) {
+            *out = names[i].second;
+            return;
+          }
+          expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i].first;
+        }
+        fail(n, p, "expected " + expected);
+      };
+    };
     constexpr double kHour = 3600.0;
 
     const std::map<std::string, Handler> model = {
@@ -212,39 +229,12 @@ class Loader {
          }},
     };
     const std::map<std::string, Handler> identification = {
-        {"method",
-         [&](const YAML::Node& n, const std::string& p) {
-           const std::string m = text(n, p);
-           if (m == "kreisselmeier") {
-             id.method = IdentMethod::kKreisselmeier;
-           } else if (m == "paper") {
-             id.method = IdentMethod::kPaper;
-           } else {
-             fail(n, p, "expected kreisselmeier or paper");
-           }
-         }},
-        {"instruments",
-         [&](const YAML::Node& n, const std::string& p) {
-           const std::string m = text(n, p);
-           if (m == "rudder") {
-             id.instruments = Instruments::kRudder;
-           } else if (m == "regressor") {
-             id.instruments = Instruments::kRegressor;
-           } else {
-             fail(n, p, "expected rudder or regressor");
-           }
-         }},
-        {"precision",
-         [&](const YAML::Node& n, const std::string& p) {
-           const std::string m = text(n, p);
-           if (m == "coefficients") {
-             id.precision = Precision::kCoefficients;
-           } else if (m == "prediction") {
-             id.precision = Precision::kPrediction;
-           } else {
-             fail(n, p, "expected coefficients or prediction");
-           }
-         }},
+        {"method", choice(&id.method, {{"kreisselmeier", IdentMethod::kKreisselmeier},
+                                       {"paper", IdentMethod::kPaper}})},
+        {"instruments", choice(&id.instruments, {{"rudder", Instruments::kRudder},
+                                                 {"regressor", Instruments::kRegressor}})},
+        {"precision", choice(&id.precision, {{"coefficients", Precision::kCoefficients},
+                                             {"prediction", Precision::kPrediction}})},
         {"eps1", num(&id.eps1, {1e-3, 1e3, "1/s"})},
         {"eps2", num(&id.eps2, {1e-3, 1e3, "1/s"})},
         {"gamma", num(&id.gamma, {0, 1e15, "1/s (paper law: 1/(psi^2 s))"})},

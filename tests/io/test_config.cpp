@@ -149,6 +149,8 @@ identification:
   cubic_correction: false
   instruments: regressor
   max_std_error: 0.2
+  precision: prediction
+  max_prediction_error: 0.03
   guard: false
   guard_threshold: 50
   guard_min_shift: 0.002
@@ -165,6 +167,9 @@ isolation:
   sigma_v: 0.01
   sigma_r: 0.001
   stuck_min_samples: 7
+  stuck_probability: 1e-6
+  stuck_learn_time: 30
+  stuck_time_max: 4
   spike_count: 5
   classify_window: 9
   second_fault_time: 3.5
@@ -188,6 +193,11 @@ service:
   EXPECT_FALSE(c.identification.cubic_correction);
   EXPECT_EQ(c.identification.instruments, Instruments::kRegressor);
   EXPECT_EQ(c.identification.max_std_error, 0.2);
+  EXPECT_EQ(c.identification.precision, Precision::kPrediction);
+  EXPECT_EQ(c.identification.max_prediction_error, 0.03);
+  EXPECT_EQ(c.isolation.stuck_probability, 1e-6);
+  EXPECT_EQ(c.isolation.stuck_learn_time, 30.0);
+  EXPECT_EQ(c.isolation.stuck_time_max, 4.0);
   EXPECT_FALSE(c.identification.guard);
   EXPECT_EQ(c.identification.guard_threshold, 50.0);
   EXPECT_EQ(c.identification.guard_min_shift, 0.002);
@@ -217,6 +227,9 @@ TEST(ConfigError, WrongTypeNamesFileKeyLineAndValue) {
   EXPECT_MENTIONS(s, "cfg_test.yaml:3", "isolation", "'5'", "mapping");
   const std::string e = error_of("model:\n  B: [1, x]\n");
   EXPECT_MENTIONS(e, "cfg_test.yaml:2", "model.B[1]", "'x'");
+  const std::string c = error_of("model:\n  B: [1, 2]\nidentification:\n  precision: fine\n");
+  EXPECT_MENTIONS(c, "cfg_test.yaml:4", "identification.precision", "'fine'",
+                  "expected coefficients or prediction");
 }
 
 TEST(ConfigError, WrongListLengthNamesFileKeyLineAndValue) {
