@@ -375,7 +375,7 @@ void FdiPipeline::process(const Sample& s) {
 }
 
 void FdiPipeline::await_estimate() {
-  if (ident_pushed_ > 0) {
+  if (ident_pushed_ > 0 && opt_.estimate_wait > 0.0) {
     using Clock = std::chrono::steady_clock;
     std::unique_lock<std::mutex> lock(step_m_);
     // Dropped hand-overs (a full queue, oldest first) will never be handled.

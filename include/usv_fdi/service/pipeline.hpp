@@ -115,7 +115,8 @@ struct PipelineOptions {
   /// for it takes no time when samples arrive at their rate (identification needs about a
   /// microsecond per sample); it is bounded by this wall-clock time, after which isolation
   /// goes on with the estimate it has, logs that the identification thread lags behind, and
-  /// waits again once it has caught up [s].
+  /// waits again once it has caught up [s]. 0: never waits (the isolation thread takes
+  /// whatever estimate is there; results then depend on scheduling).
   double estimate_wait = 5.0;
   /// Operators allowed to acknowledge (empty: anyone who can write the ack topic).
   std::vector<std::string> authorised_operators;
