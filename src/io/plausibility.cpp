@@ -131,14 +131,30 @@ std::string convergence_report(const Estimate& est, const IdentificationParams& 
     if (!std::isfinite(est.uncertainty)) {
       why.push_back("standard errors not known yet (fewer than three batches of data)");
     } else if (est.uncertainty > limit || est.status == IdentStatus::kImprecise) {
-      why.push_back(format(prediction
-                               ? "the standard errors of A allow an error of %.3g %% in the "
-                                 "model's prediction (its upper 90 %% confidence bound must be "
-                                 "below identification.max_prediction_error = %g %%)"
-                               : "the largest standard error of an a_n is %.3g %% of its value "
-                                 "(its upper 90 %% confidence bound must be below "
-                                 "identification.max_std_error = %g %%)",
-                           100.0 * est.uncertainty, 100.0 * limit));
+      if (prediction) {
+        why.push_back(
+            format("the standard errors of A allow an error of %.3g %% in the model's "
+                   "prediction (its upper 90 %% confidence bound must be below "
+                   "identification.max_prediction_error = %g %%)",
+                   100.0 * est.uncertainty, 100.0 * limit));
+      } else {
+        // Name the a_n whose relative standard error is the largest.
+        int worst_n = 0;
+        double worst = -1.0;
+        for (int n = 0; n < 4; ++n) {
+          const double rel =
+              est.std_error(n) / std::max(std::abs(to_params(est.A)(n)), p.settle_floor);
+          if (rel > worst) {
+            worst = rel;
+            worst_n = n;
+          }
+        }
+        why.push_back(
+            format("the largest standard error, of a%.0f, is %.3g %% of its value (its "
+                   "upper 90 %% confidence bound must be below identification."
+                   "max_std_error = %g %%)",
+                   worst_n + 1.0, 100.0 * worst, 100.0 * limit));
+      }
     }
   }
   if (!est.consistent || est.inconsistent_time > 0.0) {

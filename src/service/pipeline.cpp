@@ -323,10 +323,9 @@ void FdiPipeline::process(const Sample& s) {
                "consistently from t=%.3f s: detection and identification restarted",
                iso_.clock().resync_from(), s.t));
   }
-  if (!ok && iso_.last_was_duplicate()) {
-    ++duplicates_;  // the previous sample once more (a source or link repeated it): dropped
-    return;
-  }
+  // The previous sample once more (a source or link repeated it): dropped, and counted by
+  // the isolation stage.
+  if (!ok && iso_.last_was_duplicate()) return;
   if (!ok || resynced) {
     assembler_.rebase(iso_.clock().last(), cfg_.clock_max_jump);
   }
@@ -572,7 +571,7 @@ PipelineStatus FdiPipeline::make_status() {
   st.isolation = iso_.status();
   st.samples = samples_.load();
   st.rejected = rejected_.load();
-  st.duplicates = duplicates_.load();
+  st.duplicates = iso_.duplicate_samples();
   st.clock_resyncs = iso_.clock().resyncs();
   st.dropped_inputs = input_.dropped();
   st.dropped_ident = ident_q_.dropped();

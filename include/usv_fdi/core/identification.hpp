@@ -359,10 +359,12 @@ class Identifier {
   void remove_segment(std::uint64_t id);
   void commit_mixing(bool rudder_iv);
   void update_std_error();
-  /// What the remaining uncertainty of A does to the model's prediction, not to each a_n
-  /// (the tiny a_n of a slow ship never pass a relative test and barely matter): per row i,
-  /// the RMS over the memory's regressors q of the upper-bound standard error of a_i^T q,
-  /// relative to prediction_scale; the larger row (inf while there are no standard errors).
+  /// The largest upper-bound relative standard error (inf while there are none):
+  /// Precision::kCoefficients, of each a_n relative to max(|a_n|, settle_floor);
+  /// Precision::kPrediction, what the uncertainty of A does to the model's prediction (the
+  /// tiny a_n of a slow ship never pass a relative test and barely matter): per row i, the
+  /// RMS over the memory's regressors q of the error of a_i^T q, relative to
+  /// prediction_scale.
   double relative_std_error(const Vec4& a) const;
   /// Row i's prediction scale over the memory: RMS(a_i1 q_1) + RMS(a_i2 q_2).
   double prediction_scale(const Vec4& a, int i) const;

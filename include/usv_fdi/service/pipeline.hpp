@@ -395,7 +395,7 @@ class FdiPipeline {
   std::array<FaultEvent, 3> latest_{};
   std::array<std::uint64_t, 3> published_seq_{0, 0, 0};
 
-  std::atomic<std::uint64_t> samples_{0}, rejected_{0}, duplicates_{0};
+  std::atomic<std::uint64_t> samples_{0}, rejected_{0};
   std::atomic<std::uint64_t> inputs_handled_{0}, events_emitted_{0};
   // Estimate hand-over: samples handed to the identification thread (isolation thread only)
   // and handled by it (under step_m_); ident_lagging_: the last wait timed out (isolation).
