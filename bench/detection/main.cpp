@@ -44,6 +44,9 @@ int main(int argc, char** argv) {
                  "source tree)");
   app.add_flag("--no-realdata", no_realdata, "leave the recorded data out");
   app.add_flag("--no-progress", no_progress, "no progress line on stderr");
+  app.add_flag("--speed", opt.speed,
+               "give every method the surge speed u (voyages: the simulated log; HSVA: the data's "
+               "column u); default: B only");
   CLI11_PARSE(app, argc, argv);
   opt.progress = !no_progress;
 
@@ -68,12 +71,12 @@ int main(int argc, char** argv) {
     const std::time_t now = std::time(nullptr);
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
     char head[512];
-    std::snprintf(head, sizeof head, "`%s` (%s mode), %s, %zu runs in %.0f s on %d thread(s).%s%s",
-                  command.c_str(), opt.quick ? "quick" : "full", date, cases.size(), secs, opt.jobs,
-                  opt.realdata_dir.empty() ? " Real data left out: " : "",
-                  opt.realdata_dir.empty()
-                      ? (no_realdata ? "--no-realdata" : opt.realdata_note.c_str())
-                      : "");
+    std::snprintf(
+        head, sizeof head, "`%s` (%s mode%s), %s, %zu runs in %.0f s on %d thread(s).%s%s",
+        command.c_str(), opt.quick ? "quick" : "full", opt.speed ? ", with the speed input" : "",
+        date, cases.size(), secs, opt.jobs, opt.realdata_dir.empty() ? " Real data left out: " : "",
+        opt.realdata_dir.empty() ? (no_realdata ? "--no-realdata" : opt.realdata_note.c_str())
+                                 : "");
     const std::string md = to_markdown(tables, head);
     std::cout << md;
     if (!md_file.empty()) {

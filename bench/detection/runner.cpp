@@ -253,7 +253,10 @@ Stream voyage_stream(const std::shared_ptr<const sim::Hull>& hull, const std::st
   sim::Voyage run(hull, c);
   sim::VoyageRow row;
   st.samples.reserve(static_cast<std::size_t>(duration * rate) + 2);
-  while (run.next(&row)) st.samples.push_back(Sample{row.t, row.v, row.r, row.delta});
+  while (run.next(&row)) {
+    // The surge speed as a log measures it (Sample::u; used with --speed only).
+    st.samples.push_back(Sample{row.t, row.v, row.r, row.delta, row.u_true});
+  }
   for (const FaultInjection& f : faults) {
     st.faults.push_back(InjectedFault{f.sensor, f.kind, f.t_start, f.t_end});
   }
@@ -435,6 +438,16 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
           }
         }
       }
+    }
+  }
+  if (!opt.speed) {
+    // B only, as a user without a speed log gives it: the samples' u is dropped.
+    for (Case& c : cases) {
+      c.make = [make = std::move(c.make)] {
+        Stream st = make();
+        for (Sample& x : st.samples) x.u = kNaN;
+        return st;
+      };
     }
   }
   return cases;

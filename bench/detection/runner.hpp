@@ -60,6 +60,9 @@ struct BenchOptions {
   std::string realdata_note;
   std::string only;  ///< run only the tables whose name contains this
   bool progress = true;
+  /// Give the engine the surge speed (Sample::u: the voyage's, the HSVA data's column u);
+  /// false: B only, u dropped.
+  bool speed = false;
   ScoreParams score;
 };
 

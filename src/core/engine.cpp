@@ -25,6 +25,7 @@ void EngineConfig::validate() const {
   }
   identification.validate();
   isolation.validate();
+  speed.validate();
 }
 
 SampleClock::Verdict SampleClock::check(double t) {
@@ -64,15 +65,20 @@ bool IdentificationGate::pop(Sample* s, bool* freeze) {
 IdentificationStage::IdentificationStage(const EngineConfig& cfg)
     : params_((cfg.validate(), cfg.identification)),
       B_(cfg.B),
+      speed_(cfg.speed),
       delay_(cfg.identification_delay),
-      ident_(params_, B_),
+      ident_(params_, B_, speed_),
       gate_(delay_) {}
 
 bool IdentificationStage::push(const IdentificationInput& in) {
   if (in.restart) {
     // A new time base: the filters, memories and the samples waiting in the gate belong to
     // the old one. The estimator starts afresh, as at start-up.
-    ident_ = Identifier(params_, B_);
+    // B is given at the reference speed: a new time base keeps it.
+    if (std::isfinite(ident_.speed().reference_speed())) {
+      speed_.reference_speed = ident_.speed().reference_speed();
+    }
+    ident_ = Identifier(params_, B_, speed_);
     gate_ = IdentificationGate(delay_);
   }
   gate_.push(in.sample, in.freeze);
@@ -91,11 +97,15 @@ bool IdentificationStage::push(const IdentificationInput& in) {
 IsolationStage::IsolationStage(const EngineConfig& cfg)
     : params_((cfg.validate(), cfg.isolation)),
       B_(cfg.B),
+      speed_(cfg.speed),
       clock_(cfg.clock_max_jump, cfg.clock_confirm_samples),
-      iso_(params_, B_) {}
+      iso_(params_, B_, speed_) {}
 
 void IsolationStage::restart(const Sample& s) {
-  iso_ = Isolator(params_, B_);
+  if (std::isfinite(iso_.speed().reference_speed())) {
+    speed_.reference_speed = iso_.speed().reference_speed();
+  }
+  iso_ = Isolator(params_, B_, speed_);
   estimate_ = Estimate{};
   estimate_.t = s.t;
 }
@@ -110,7 +120,7 @@ bool IsolationStage::process(const Sample& s, std::vector<FaultEvent>* events,
   // One sample delivered twice is dropped; a third copy is a clock that stands still.
   last_duplicate_ = !repeated_ && std::isfinite(s.t) && s.t == last_accepted_.t &&
                     same(s.v, last_accepted_.v) && same(s.r, last_accepted_.r) &&
-                    same(s.delta, last_accepted_.delta);
+                    same(s.delta, last_accepted_.delta) && same(s.u, last_accepted_.u);
   if (last_duplicate_) {
     ++duplicates_;
     repeated_ = true;

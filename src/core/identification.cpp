@@ -102,8 +102,14 @@ void Identifier::Memory::append(const Memory& seg) {
   W2 = E2 * W2 + seg.W2;
 }
 
-Identifier::Identifier(const IdentificationParams& params, const Vec2& B)
-    : p_(params), B_(B), f1_(params.eps1), f2_(params.eps2), a_(params.a0), a_ref_(params.a0) {
+Identifier::Identifier(const IdentificationParams& params, const Vec2& B, const SpeedParams& speed)
+    : p_(params),
+      B_(B),
+      f1_(params.eps1),
+      f2_(params.eps2),
+      speed_(speed),
+      a_(params.a0),
+      a_ref_(params.a0) {
   p_.validate();
   if (!B.allFinite()) throw std::invalid_argument("model.B must be finite");
   const double eps_min = p_.method == IdentMethod::kPaper ? std::min(p_.eps1, p_.eps2) : p_.eps1;
@@ -116,21 +122,30 @@ Identifier::Identifier(const IdentificationParams& params, const Vec2& B)
   A_aux_ << -p_.eps1, p_.eps1, -p_.eps1, -p_.eps1;
 }
 
-void Identifier::step_instruments(double dt, double delta_prev) {
-  if (std::abs(dt - h_aux_) > 1e-9 * dt) {
-    // Exact ZOH discretisation of x' = A_aux x + B delta over dt.
+void Identifier::step_instruments(double dt, double delta_prev, double s_prev, double s_now) {
+  // At speed ratio s the auxiliary model is x' = s A_aux x + s^2 B delta: A_aux over the
+  // vessel's own time s dt, driven by s delta (s in steps of speed.quantum, so that a
+  // slowly changing speed does not re-discretise on every sample).
+  if (std::abs(s_now - s_aux_) > speed_.params().quantum * s_aux_) {
+    s_aux_ = s_now;
+    h_aux_ = -1.0;
+  }
+  const double h = s_aux_ * dt;
+  if (std::abs(h - h_aux_) > 1e-9 * h) {
+    // Exact ZOH discretisation of x' = A_aux x + B delta over h.
     Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-    M.topLeftCorner<2, 2>() = A_aux_ * dt;
-    M.topRightCorner<2, 1>() = B_ * dt;
+    M.topLeftCorner<2, 2>() = A_aux_ * h;
+    M.topRightCorner<2, 1>() = B_ * h;
     const Eigen::Matrix3d E = M.exp();
     Ad_aux_ = E.topLeftCorner<2, 2>();
     Bd_aux_ = E.topRightCorner<2, 1>();
-    h_aux_ = dt;
+    h_aux_ = h;
   }
   const Vec2 x_prev = x_aux_;
-  x_aux_ = Ad_aux_ * x_aux_ + Bd_aux_ * delta_prev;
-  // F1 as for q (first-order hold; the instruments need no particular accuracy).
-  for (int i = 0; i < 2; ++i) z_(i) = f1_.step(x_prev(i), x_aux_(i), z_(i));
+  x_aux_ = Ad_aux_ * x_aux_ + Bd_aux_ * (speed_.input_factor(s_aux_) / s_aux_ * delta_prev);
+  // F1[s x_aux] as the regressor F1[s y] (first-order hold; the instruments need no
+  // particular accuracy).
+  for (int i = 0; i < 2; ++i) z_(i) = f1_.step(s_prev * x_prev(i), s_now * x_aux_(i), z_(i));
 }
 
 void Identifier::refresh_aux_model(double t) {
@@ -169,6 +184,9 @@ void Identifier::restart_filters(const Sample& s) {
   qb_.setZero();
   mb_.setZero();
   fd1_ = fd2_ = 0.0;
+  qs_.setZero();
+  fds_ = 0.0;
+  s_prev_ = speed_.ratio();
   z_.setZero();  // x_aux_ carries on: it depends on the rudder only
   // A window must not straddle the restart (the sums after it use fresh filters), and the
   // data no window has judged yet is dropped with them.
@@ -193,6 +211,9 @@ bool Identifier::update(const Sample& s, bool freeze) {
   if (!std::isnan(t_last_) && !(s.t > t_last_)) return false;
   t_last_ = s.t;
   est_.t = s.t;
+  const double sr = speed_.update(s);
+  est_.speed_ratio = sr;
+  est_.reference_speed = speed_.reference_speed();
   if (freeze) {
     est_.frozen = true;
     restart_pending_ = true;
@@ -227,13 +248,27 @@ bool Identifier::update(const Sample& s, bool freeze) {
   f1_.set_step(dt, hp);
   for (int i = 0; i < 2; ++i) q_(i) = f1_.step_cubic(y_prev(i), y(i), dd(i), c3(i), q_(i));
   fd1_ = f1_.step_cubic(prev_.delta, s.delta, dd(2), c3(2), fd1_);
-  m_ = p_.eps1 * (y - q_) - B_ * fd1_;
+  // The paper's method is kept as written: it knows no speed.
+  if (speed_.measured() && p_.method != IdentMethod::kPaper) {
+    // The curvature and cubic terms of s y are taken as s times those of y (s changes
+    // slowly); the end points are exact.
+    const double sp = s_prev_;
+    for (int i = 0; i < 2; ++i) {
+      qs_(i) = f1_.step_cubic(sp * y_prev(i), sr * y(i), sr * dd(i), sr * c3(i), qs_(i));
+    }
+    const double kp = speed_.input_factor(sp), kn = speed_.input_factor(sr);
+    fds_ = f1_.step_cubic(kp * prev_.delta, kn * s.delta, kn * dd(2), kn * c3(2), fds_);
+  } else {
+    qs_ = q_;
+    fds_ = fd1_;
+  }
+  m_ = p_.eps1 * (y - q_) - B_ * fds_;
   const bool rudder_iv =
       p_.method == IdentMethod::kKreisselmeier && p_.instruments == Instruments::kRudder;
   if (rudder_iv) {
-    step_instruments(dt, prev_.delta);
+    step_instruments(dt, prev_.delta, s_prev_, sr);
   } else {
-    z_ = q_;
+    z_ = qs_;
   }
   if (p_.method == IdentMethod::kPaper) {
     f2_.set_step(dt, hp);
@@ -244,6 +279,7 @@ bool Identifier::update(const Sample& s, bool freeze) {
   prev2_ = prev_;
   have_prev2_ = true;
   prev_ = s;
+  s_prev_ = sr;
   est_.warming_up = s.t - t_start_ < warmup_;
   if (est_.warming_up) {
     if (!est_.converged) est_.status = IdentStatus::kWarmingUp;
@@ -273,7 +309,7 @@ bool Identifier::update(const Sample& s, bool freeze) {
 
 void Identifier::step_memories(double t, double dt, bool rudder_iv) {
   const double E = std::exp(-p_.lambda * dt);
-  seg_.step(E, dt, q_, m_, z_);
+  seg_.step(E, dt, qs_, m_, z_);
   // Tapered window sums of z q^T, z m^T, z z^T (two Hann windows, half a window apart).
   const double T_b = kBatchLength / p_.eps1;
   for (Batch& b : open_) {
@@ -281,7 +317,7 @@ void Identifier::step_memories(double t, double dt, bool rudder_iv) {
     b.T += dt;
     const double sn = std::sin(M_PI * std::min(1.0, b.T / T_b));
     const double w = sn * sn;  // Hann window
-    b.P += w * dt * (z_ * q_.transpose());
+    b.P += w * dt * (z_ * qs_.transpose());
     b.G += w * dt * (z_ * m_.transpose());
     b.Z += w * w * dt * (z_ * z_.transpose());
     b.H2 += w * w * dt;

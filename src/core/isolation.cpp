@@ -126,7 +126,8 @@ void Isolator::Window::push(double x, std::size_t n) {
   }
 }
 
-Isolator::Isolator(const IsolationParams& params, const Vec2& B) : p_(params), B_(B) {
+Isolator::Isolator(const IsolationParams& params, const Vec2& B, const SpeedParams& speed)
+    : p_(params), B_(B), speed_(speed) {
   p_.validate();
   if (!B.allFinite()) throw std::invalid_argument("model.B must be finite");
   scales_configured_ = p_.sigma_v > 0;
@@ -151,6 +152,9 @@ bool Isolator::design(const Mat2& A, Bank* b) {
   b->g.set_channel(kR);
   b->v.set_design(dv, B_);
   b->g.set_design(dg, B_);
+  const double band = speed_.measured() ? speed_.params().quantum : 0.0;
+  b->v.set_step_band(band);
+  b->g.set_step_band(band);
   b->A = A;
   b->k_v = dv.k;
   b->k_g = dg.k;
@@ -298,6 +302,16 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   if (have_prev_ && !(s.t > prev_.t)) return reject_timestamp(out);
   const double dt = have_prev_ ? s.t - prev_.t : 0.0;
   ++st_.samples;
+  const bool had_speed = speed_.measured();
+  st_.speed_ratio = speed_.update(s);
+  in_obs_ = speed_.input_factor(st_.speed_ratio) / st_.speed_ratio;
+  if (speed_.measured() && !had_speed) {
+    // The observers' step (the vessel's own time) now moves a little on every sample.
+    for (Bank* b : {&act_, &shadow_}) {
+      b->v.set_step_band(speed_.params().quantum);
+      b->g.set_step_band(speed_.params().quantum);
+    }
+  }
   if (have_prev_ && dt > p_.stale_timeout) ++st_.input.gaps;
   sensor_checks(s, out);
   if (st_.armed) residual_checks(s, dt, out);
@@ -457,8 +471,10 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
   const double yr = pr ? prev_.r : b->v.x()(1);
   const bool use_v = pv || (fa && !fg);
   const bool use_r = pr || (fg && !fa);
-  b->v.step(dt, d, d_new, yv, use_v);
-  b->g.step(dt, d, d_new, yr, use_r);
+  // At speed ratio s: A0 over the vessel's own time s dt, driven by s^(k-1) delta.
+  const double h = st_.speed_ratio * dt, k = in_obs_;
+  b->v.step(h, k * d, k * d_new, yv, use_v);
+  b->g.step(h, k * d, k * d_new, yr, use_r);
 }
 
 bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
@@ -551,7 +567,8 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     for (int c = 0; c < 2; ++c) {
       if (!mon_on_[c]) continue;
       const double y = c == kV ? prev_.v : prev_.r;
-      mon_[c].step(dt, dp, dn, y, usable(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
+      mon_[c].step(st_.speed_ratio * dt, in_obs_ * dp, in_obs_ * dn, y,
+                   usable(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
     }
   }
   // A sensor whose fault cleared drives its dedicated observer again. While it was faulty

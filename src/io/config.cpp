@@ -227,6 +227,14 @@ class Loader {
            id.a0 = vector<4>(n, p, {-1e3, 1e3, "1/s"});
            remember(n, "identification.a0");  // the name validate() uses
          }},
+        {"reference_speed",
+         num(&cfg.speed.reference_speed, {0, 1e3, "m/s (0: the first measured speed)"})},
+    };
+    const std::map<std::string, Handler> speed = {
+        {"min_ratio", num(&cfg.speed.min_ratio, {0, 1e3, ""})},
+        {"max_ratio", num(&cfg.speed.max_ratio, {0, 1e3, ""})},
+        {"quantum", num(&cfg.speed.quantum, {0, 1, ""})},
+        {"input_exponent", num(&cfg.speed.input_exponent, {0, 3, ""})},
     };
     const std::map<std::string, Handler> identification = {
         {"method", choice(&id.method, {{"kreisselmeier", IdentMethod::kKreisselmeier},
@@ -307,6 +315,7 @@ class Loader {
         {"model", sub(model)},
         {"identification", sub(identification)},
         {"isolation", sub(isolation)},
+        {"speed", sub(speed)},
         // Parsed by the DDS service (through `extra`); otherwise accepted as any mapping.
         {"service",
          [this](const YAML::Node& n, const std::string& p) {

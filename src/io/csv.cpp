@@ -168,6 +168,7 @@ void CsvSampleReader::read_header() {
     for (int k = 0; k < 4; ++k) {
       if (header_[i] == kRequired[k]) col_[k] = static_cast<int>(i);
     }
+    if (header_[i] == "u") col_u_ = static_cast<int>(i);
   }
   for (int k = 0; k < 4; ++k) {
     if (col_[k] < 0) {
@@ -197,6 +198,11 @@ bool CsvSampleReader::next(Sample* s) {
   s->v = x[1];
   s->r = x[2];
   s->delta = x[3];
+  s->u = kNaN;
+  if (col_u_ >= 0) {
+    const std::string& f = fields_[static_cast<std::size_t>(col_u_)];
+    if (!parse_csv_number(f, &s->u)) throw InputError(name_, line_, "u", f, "not a number");
+  }
   ++rows_;
   return true;
 }

@@ -137,7 +137,9 @@ void JsonlWriter::estimate(double t, const Estimate& est, bool armed) {
        << ",\"status\":" << json_string(to_string(est.status))
        << ",\"settling\":" << json_number(est.settling)
        << ",\"uncertainty\":" << json_number(est.uncertainty)
-       << ",\"std_error\":" << array4(est.std_error) << "}\n";
+       << ",\"std_error\":" << array4(est.std_error)
+       << ",\"speed_ratio\":" << json_number(est.speed_ratio)
+       << ",\"reference_speed\":" << json_number(est.reference_speed) << "}\n";
 }
 
 void JsonlWriter::summary(const RunSummary& s) {

@@ -59,6 +59,11 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(x.settle_tolerance, y.settle_tolerance);
   EXPECT_EQ(x.settle_windows, y.settle_windows);
   EXPECT_EQ(x.settle_floor, y.settle_floor);
+  EXPECT_EQ(a.speed.reference_speed, b.speed.reference_speed);
+  EXPECT_EQ(a.speed.min_ratio, b.speed.min_ratio);
+  EXPECT_EQ(a.speed.max_ratio, b.speed.max_ratio);
+  EXPECT_EQ(a.speed.quantum, b.speed.quantum);
+  EXPECT_EQ(a.speed.input_exponent, b.speed.input_exponent);
   const IsolationParams &p = a.isolation, &q = b.isolation;
   EXPECT_EQ(p.poles_v, q.poles_v);
   EXPECT_EQ(p.poles_g, q.poles_g);

@@ -52,6 +52,22 @@ TEST(Csv, ReadsRequiredColumnsInAnyOrderAndIgnoresOthers) {
   EXPECT_EQ(r->rows(), 2u);
 }
 
+TEST(Csv, ReadsTheOptionalSpeedColumn) {
+  // Without a u column the speed is not measured; with one it is read (empty: missing).
+  auto plain = reader("t,v,r,delta\n0,0,0,0\n");
+  Sample s;
+  ASSERT_TRUE(plain->next(&s));
+  EXPECT_TRUE(std::isnan(s.u));
+  auto with_u = reader("t,u,v,r,delta\n0,2.5,0,0,0\n1,,0,0,0\n");
+  ASSERT_TRUE(with_u->next(&s));
+  EXPECT_EQ(s.u, 2.5);
+  ASSERT_TRUE(with_u->next(&s));
+  EXPECT_TRUE(std::isnan(s.u));
+  const InputError e = error_of("t,v,r,delta,u\n0,0,0,0,fast\n");
+  EXPECT_EQ(e.column(), "u");
+  EXPECT_TRUE(contains(e.what(), "fast")) << e.what();
+}
+
 TEST(Csv, MissingValuesAreNaN) {
   auto r = reader("t,v,r,delta\n0,nan,NaN,\n1, ,1e-3,0\n");
   Sample s;

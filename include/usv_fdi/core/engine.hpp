@@ -13,6 +13,7 @@
 #include "usv_fdi/core/identification.hpp"
 #include "usv_fdi/core/isolation.hpp"
 #include "usv_fdi/core/latch.hpp"
+#include "usv_fdi/core/speed.hpp"
 
 namespace usvfdi {
 
@@ -20,6 +21,7 @@ struct EngineConfig {
   Vec2 B = Vec2::Zero();  ///< known input vector B = M^-1 B_R (the only required setting)
   IdentificationParams identification;
   IsolationParams isolation;
+  SpeedParams speed;  ///< the optional speed input (core/speed.hpp)
   /// Identification consumes samples this much later than isolation, so that a fault
   /// detected within the delay never reaches the estimator [s].
   double identification_delay = 0.5;
@@ -99,6 +101,7 @@ class IdentificationStage {
  private:
   IdentificationParams params_;
   Vec2 B_;
+  SpeedParams speed_;  ///< with the reference speed once known (kept over restarts)
   double delay_;
   Identifier ident_;
   IdentificationGate gate_;
@@ -147,6 +150,7 @@ class IsolationStage {
 
   IsolationParams params_;
   Vec2 B_;
+  SpeedParams speed_;  ///< with the reference speed once known (kept over restarts)
   SampleClock clock_;
   std::uint64_t rejected_ = 0;
   std::uint64_t duplicates_ = 0;

@@ -76,6 +76,7 @@
 #include <vector>
 
 #include "usv_fdi/core/filters.hpp"
+#include "usv_fdi/core/speed.hpp"
 #include "usv_fdi/core/types.hpp"
 
 namespace usvfdi {
@@ -169,8 +170,11 @@ const char* to_string(IdentStatus s);
 
 /// One snapshot of the identification state (published by the identification thread).
 struct Estimate {
-  double t = kNaN;           ///< time of the last sample used [s]
-  Mat2 A = Mat2::Zero();     ///< current estimate of A
+  double t = kNaN;        ///< time of the last sample used [s]
+  Mat2 A = Mat2::Zero();  ///< current estimate of A (with a speed input: A0, at U0)
+  /// With a speed input: s = u / U0 of the last sample, and U0 [m/s] (1 and NaN without).
+  double speed_ratio = 1.0;
+  double reference_speed = kNaN;
   bool converged = false;    ///< sticky once the criterion held
   double excitation = 0.0;   ///< normalised excitation of the extended regressor, [0,1]
   double psi = 0.0;          ///< mixed regressor psi
@@ -217,8 +221,9 @@ struct Estimate {
 
 class Identifier {
  public:
-  /// Throws std::invalid_argument on bad parameters.
-  Identifier(const IdentificationParams& params, const Vec2& B);
+  /// Throws std::invalid_argument on bad parameters. With a speed input (Sample::u) the
+  /// estimate is A0, A at the reference speed (core/speed.hpp), and B is B0.
+  Identifier(const IdentificationParams& params, const Vec2& B, const SpeedParams& speed = {});
 
   /// Feeds one sample. With freeze = true nothing in the estimator's memory changes (the
   /// filters restart, with a warm-up, on the first sample after the freeze).
@@ -237,17 +242,20 @@ class Identifier {
   /// Latest mixed quantities, for tests of the DREM identity h_n = psi a_n.
   double psi() const { return psi_; }
   const Vec4& h() const { return h_; }
-  /// Latest regression pair (m = A q holds for noise-free data).
-  const Vec2& q() const { return q_; }
+  /// Latest regression pair (m = A q holds for noise-free data; with a speed input q is
+  /// F1[s y] and A is A0).
+  const Vec2& q() const { return qs_; }
   const Vec2& m() const { return m_; }
   /// Latest instrument vector (z = q for the regressor instruments).
   const Vec2& z() const { return z_; }
   /// The auxiliary model's matrix A_aux that generates the rudder instruments.
   const Mat2& aux_model() const { return A_aux_; }
+  /// The speed ratio s = u / U0 (1 without a speed input).
+  const SpeedRatio& speed() const { return speed_; }
 
  private:
   void restart_filters(const Sample& s);
-  void step_instruments(double dt, double delta_prev);
+  void step_instruments(double dt, double delta_prev, double s_prev, double s_now);
   void refresh_aux_model(double t);
   void advance_scalar_laws(double dt);
   void update_convergence(double t);
@@ -271,6 +279,13 @@ class Identifier {
   Vec2 q_ = Vec2::Zero(), m_ = Vec2::Zero();
   Vec2 qb_ = Vec2::Zero(), mb_ = Vec2::Zero();
   double fd1_ = 0.0, fd2_ = 0.0;
+  // Speed (core/speed.hpp): x' = s A0 x + s^2 B0 delta, so m = F1[x'] - B0 F1[s^2 delta] =
+  // A0 F1[s x]: the regressor qs_ = F1[s y] and fds_ = F1[s^2 delta] (q_ and fd1_ when s = 1).
+  SpeedRatio speed_;
+  double s_prev_ = 1.0;     ///< s of prev_
+  double s_aux_ = 1.0;      ///< s of the instruments' discretisation (steps of speed.quantum)
+  Vec2 qs_ = Vec2::Zero();  ///< F1[s y], the regressor
+  double fds_ = 0.0;        ///< F1[s^2 delta]
   // Rudder instruments: auxiliary model x_aux' = A_aux x_aux + B delta, z = F1[x_aux].
   Mat2 A_aux_;
   Mat2 Ad_aux_ = Mat2::Identity();

@@ -20,6 +20,7 @@
 
 #include "usv_fdi/core/identification.hpp"
 #include "usv_fdi/core/observer.hpp"
+#include "usv_fdi/core/speed.hpp"
 #include "usv_fdi/core/types.hpp"
 
 namespace usvfdi {
@@ -134,14 +135,16 @@ struct IsolatorStatus {
   Vec2 s = Vec2::Zero();  ///< latest structured residual [m/s, rad/s] (NaN where unusable)
   Vec2 d = Vec2::Zero();  ///< latest cross residual, the fault estimate [m/s, rad/s]
   double c_a = 0.0, c_g = 0.0;
+  double speed_ratio = 1.0;  ///< s = u / U0 of the last sample (1 without a speed input)
   InputHealth input;
   std::uint64_t samples = 0;
 };
 
 class Isolator {
  public:
-  /// Throws std::invalid_argument on bad parameters.
-  Isolator(const IsolationParams& params, const Vec2& B);
+  /// Throws std::invalid_argument on bad parameters. With a speed input (Sample::u) the
+  /// observers run on A0 in the vessel's own time (core/speed.hpp), B is B0.
+  Isolator(const IsolationParams& params, const Vec2& B, const SpeedParams& speed = {});
 
   /// Installs the latest identification snapshot. Arms (designs the observers) the first
   /// time the estimate has converged; afterwards, when A moved by more than
@@ -161,6 +164,7 @@ class Isolator {
   bool freeze_requested() const { return freeze_; }
   const IsolatorStatus& status() const { return st_; }
   const IsolationParams& params() const { return p_; }
+  const SpeedRatio& speed() const { return speed_; }
 
  private:
   struct Window {
@@ -239,6 +243,8 @@ class Isolator {
 
   IsolationParams p_;
   Vec2 B_;
+  SpeedRatio speed_;
+  double in_obs_ = 1.0;  ///< the observers' input factor s^(k-1) (core/speed.hpp)
   IsolatorStatus st_;
   Bank act_;     ///< the bank in force
   Bank shadow_;  ///< a redesign learning beside it

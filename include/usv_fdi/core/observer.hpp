@@ -69,8 +69,17 @@ class DedicatedObserver {
   /// = false to run open loop for this step (invalid measurement).
   void step(double dt, double delta_prev, double delta, double y_c, bool use_measurement);
 
+  /// A step length within band (relative) of the one discretised for is taken with the
+  /// matrices corrected to first order in the difference (their derivatives in the step
+  /// length, computed with each discretisation), not re-discretised: for a step that moves
+  /// a little on every sample (the vessel's own time at a changing speed, core/speed.hpp).
+  /// 0 (the default): every other step length is discretised exactly.
+  void set_step_band(double band) { band_ = band; }
+
  private:
   void discretise(double dt);
+  /// Phi, Ga, Gb, Gy (and Ad) for step length h into the given outputs.
+  void discrete_matrices(double h, Mat2* Phi, Vec2* Ga, Vec2* Gb, Vec2* Gy, bool* ok) const;
   int channel_ = kV;
   bool ready_ = false;
   Mat2 A_ = Mat2::Zero();
@@ -79,6 +88,10 @@ class DedicatedObserver {
   bool discrete_ok_ = false;
   Mat2 Phi_ = Mat2::Identity(), Ad_ = Mat2::Identity();
   Vec2 Ga_ = Vec2::Zero(), Gb_ = Vec2::Zero(), Gy_ = Vec2::Zero();
+  double band_ = 0.0;
+  bool have_deriv_ = false;  ///< the derivatives below belong to dt_
+  Mat2 dPhi_ = Mat2::Zero();
+  Vec2 dGa_ = Vec2::Zero(), dGb_ = Vec2::Zero(), dGy_ = Vec2::Zero();
   Vec2 x_ = Vec2::Zero();
 };
 

@@ -27,6 +27,8 @@ struct Sample {
   double v = kNaN;      ///< sway velocity from the accelerometer channel [m/s]
   double r = kNaN;      ///< yaw rate from the gyro [rad/s]
   double delta = kNaN;  ///< rudder angle [rad]
+  /// Surge speed through the water [m/s], optional (NaN: not measured; core/speed.hpp).
+  double u = kNaN;
 };
 
 /// The INS sensor a fault is attributed to.

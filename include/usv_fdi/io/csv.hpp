@@ -1,7 +1,8 @@
 // CSV input (header + rows of t, v, r, delta) and the simulator's CSV output.
 //
-// Input: the header names the columns; t, v, r and delta are required in any order, other
-// columns are ignored. A field `nan`, `NaN` or empty is a missing value (NaN). Numbers are
+// Input: the header names the columns; t, v, r and delta are required in any order, u (the
+// surge speed through the water [m/s], core/speed.hpp) is read when present, other columns
+// are ignored. A field `nan`, `NaN` or empty is a missing value (NaN). Numbers are
 // parsed with strtod (C locale) and trailing garbage is an error. Blank lines and lines
 // starting with '#' are skipped; CRLF line ends and a UTF-8 byte order mark are accepted.
 // Refused with an InputError: a NUL byte (a binary or UTF-16 file), a carriage return inside
@@ -82,6 +83,7 @@ class CsvSampleReader {
   std::size_t rows_ = 0;
   std::vector<std::string> header_;
   int col_[4] = {-1, -1, -1, -1};  ///< field index of t, v, r, delta
+  int col_u_ = -1;                 ///< field index of the optional u
   std::vector<std::string> fields_;
   std::vector<char> buffer_;  ///< kCsvMaxLine + 1 bytes for one line
 };
