@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace usvfdi {
@@ -91,6 +92,7 @@ void IsolationParams::validate() const {
   require(enter_time >= 0, "enter_time", enter_time, "must be >= 0");
   require(leave_time >= 0, "leave_time", leave_time, "must be >= 0");
   require(second_fault_time >= 0, "second_fault_time", second_fault_time, "must be >= 0");
+  require(mismatch_window >= 0, "mismatch_window", mismatch_window, "must be >= 0");
   require(min_active_time >= 0, "min_active_time", min_active_time, "must be >= 0");
   require(c_min > 0 && c_min <= 1, "c_min", c_min, "must lie in (0, 1]");
   require(c_margin >= 0 && c_margin < 1, "c_margin", c_margin, "must lie in [0, 1)");
@@ -601,7 +603,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   for (const Condition& c : cond_) faulty = faulty || c.active;
   // Nor while identification finds the data inconsistent with the vessel's dynamics (a
   // fault no residual sees yet, e.g. one that began while the first design was learning).
-  const bool learn_ok = v_ok && r_ok && !faulty && !data_inconsistent_ &&
+  const bool learn_ok = v_ok && r_ok && !faulty && !data_inconsistent_ && !st_.model_mismatch &&
                         s.t - t_last_fault_ >= p_.resume_after_fault;
   double raw[4];
   Vec2 sw;
@@ -706,48 +708,93 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   const double eps_t = 1e-9;
   const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual,
              u_res = cond_[2].sources & kResidual;
-  // Candidate raise.
+  // Candidate raise: 0 accelerometer, 1 gyro, 2 model mismatch (not a sensor).
   int candidate = -1;
-  if (!a_res && !g_res && !u_res) {
+  int reclassify = -1;  ///< a raised sensor whose evidence turned out to be the model's
+  if (st_.model_mismatch) {
+    // Detection resumes once the model holds again: every statistic below its leave
+    // threshold for leave_time (and the verdict at least min_active_time old).
+    const bool quiet = (st_.J.array() <= p_.exit_ratio * thr.array()).all() &&
+                       (st_.D.array() <= thr_exit_d.array()).all();
+    if (!quiet) {
+      below_mm_since_ = kNaN;
+    } else {
+      if (std::isnan(below_mm_since_)) below_mm_since_ = s.t;
+      if (s.t - below_mm_since_ + eps_t >= p_.leave_time &&
+          s.t - mismatch_since_ + eps_t >= p_.min_active_time) {
+        st_.model_mismatch = false;
+        st_.mismatch_reason.clear();
+        below_mm_since_ = kNaN;
+      }
+    }
+  } else if (!a_res && !g_res && !u_res) {
     if (ratio.maxCoeff() > 1.0) {
       if (st_.c_a >= p_.c_min && st_.c_a - st_.c_g >= p_.c_margin) {
         candidate = 0;
       } else if (st_.c_g >= p_.c_min && st_.c_g - st_.c_a >= p_.c_margin) {
         candidate = 1;
       } else {
+        candidate = 2;  // both channels at once: the evidence singles out no sensor
+      }
+    }
+  } else if (!u_res && a_res != g_res) {
+    // One sensor raised: the other channel's structured residual is blind to its fault, so
+    // a single sensor fault never lights it. Soon after the raise, it rising too says the
+    // model, not the raised sensor, is wrong (the raise is withdrawn); later it is a second
+    // fault, on its own channel.
+    const int raised = a_res ? 0 : 1, other = 1 - raised;
+    if (ratio(other) > 1.0) {
+      if (s.t - raised_at_[raised] <= p_.mismatch_window) {
         candidate = 2;
+        reclassify = raised;
+      } else {
+        candidate = other;
       }
     }
-  } else if (!u_res) {
-    // One sensor already raised: the other raises on its own channel (structured residual
-    // entries are blind to each other's faults).
-    if (a_res && !g_res && ratio(1) > 1.0) candidate = 1;
-    if (g_res && !a_res && ratio(0) > 1.0) candidate = 0;
   }
-  const double enter =
-      a_res || g_res ? std::max(p_.enter_time, p_.second_fault_time) : p_.enter_time;
+  const double enter = (a_res || g_res) && candidate != 2
+                           ? std::max(p_.enter_time, p_.second_fault_time)
+                           : p_.enter_time;
   for (int k = 0; k < 3; ++k) {
-    if (k == candidate) {
-      if (std::isnan(above_since_[k])) above_since_[k] = s.t;
-      if (s.t - above_since_[k] + eps_t >= enter) {
-        const Sensor sensor = static_cast<Sensor>(k);
-        const FaultKind kind = k < 2 ? classify(k) : FaultKind::kUnknown;
-        if (k < 2) refine_at_[k] = s.t + 0.5 * p_.classify_window;
-        int c_max = 0;
-        ratio.maxCoeff(&c_max);
-        std::string msg =
-            k < 2 ? std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
-                        " channel: J_N " + std::to_string(st_.J(k)) + " > " + std::to_string(thr(k))
-                  : "residual on both channels, not isolated: J_N " + std::to_string(st_.J(c_max)) +
-                        " > " + std::to_string(thr(c_max));
-        set_condition(sensor, kResidual, true, kind, s.t, msg, out);
-        raised_at_[k] = s.t;
-        above_since_[k] = kNaN;
-        below_since_[k] = kNaN;
-      }
-    } else {
+    if (k != candidate) {
       above_since_[k] = kNaN;
+      continue;
     }
+    if (std::isnan(above_since_[k])) above_since_[k] = s.t;
+    if (s.t - above_since_[k] + eps_t < enter) continue;
+    above_since_[k] = kNaN;
+    if (k == 2) {
+      // Model mismatch: a status with its reason, counted; never a latched sensor fault.
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "residuals of both channels (J_N %.3g / %.3g against %.3g / %.3g)%s", st_.J(0),
+                    st_.J(1), thr(0), thr(1),
+                    reclassify >= 0
+                        ? reclassify == 0 ? " after an accelerometer raise" : " after a gyro raise"
+                        : "");
+      st_.model_mismatch = true;
+      st_.mismatch_reason = buf;
+      ++st_.mismatches;
+      mismatch_since_ = s.t;
+      below_mm_since_ = kNaN;
+      if (reclassify >= 0) {
+        refine_at_[reclassify] = kNaN;
+        set_condition(static_cast<Sensor>(reclassify), kResidual, false, cond_[reclassify].kind,
+                      s.t, std::string("withdrawn: model mismatch, not a sensor fault: ") + buf,
+                      out);
+        below_since_[reclassify] = kNaN;
+      }
+      continue;
+    }
+    const Sensor sensor = static_cast<Sensor>(k);
+    const FaultKind kind = classify(k);
+    refine_at_[k] = s.t + 0.5 * p_.classify_window;
+    const std::string msg = std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
+                            " channel: J_N " + std::to_string(st_.J(k)) + " > " +
+                            std::to_string(thr(k));
+    set_condition(sensor, kResidual, true, kind, s.t, msg, out);
+    raised_at_[k] = s.t;
+    below_since_[k] = kNaN;
   }
   // Refine the kind once more data after the raise shows the fault's shape.
   for (int k = 0; k < 2; ++k) {

@@ -102,6 +102,11 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   d.identification_paused(s.identification_paused);
   d.isolation_paused(s.isolation_paused);
   std::string msg;
+  // First, so that the 128 characters keep it: the residuals contradict the model.
+  if (s.isolation.model_mismatch) {
+    msg += "model mismatch, not a sensor fault (" + std::to_string(s.isolation.mismatches) +
+           " so far): " + s.isolation.mismatch_reason + "; ";
+  }
   if (s.ins_silent) msg += "INS silent; ";
   if (!in.delta_ok) msg += "rudder missing: identification and isolation paused; ";
   if (!in.v_ok) msg += "accelerometer channel unusable; ";

@@ -288,6 +288,7 @@ class Loader {
         {"enter_time", num(&is.enter_time, {0, 60, "s"})},
         {"leave_time", num(&is.leave_time, {0, kHour, "s"})},
         {"second_fault_time", num(&is.second_fault_time, {0, kHour, "s"})},
+        {"mismatch_window", num(&is.mismatch_window, {0, kHour, "s"})},
         {"min_active_time", num(&is.min_active_time, {0, kHour, "s"})},
         {"c_min", num(&is.c_min, {0, 1, ""})},
         {"c_margin", num(&is.c_margin, {0, 1, ""})},

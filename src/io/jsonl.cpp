@@ -130,6 +130,11 @@ void JsonlWriter::event(const FaultEvent& e) {
        << ",\"a\":" << array4(to_params(e.A)) << ",\"message\":" << json_string(e.message) << "}\n";
 }
 
+void JsonlWriter::mismatch(double t, bool active, const std::string& reason) {
+  out_ << "{\"type\":\"mismatch\",\"t\":" << json_number(t) << ",\"active\":" << boolean(active)
+       << ",\"reason\":" << json_string(active ? reason : "model holds again") << "}\n";
+}
+
 void JsonlWriter::estimate(double t, const Estimate& est, bool armed) {
   out_ << "{\"type\":\"estimate\",\"t\":" << json_number(t) << ",\"a\":" << array4(to_params(est.A))
        << ",\"converged\":" << boolean(est.converged)
@@ -144,10 +149,11 @@ void JsonlWriter::estimate(double t, const Estimate& est, bool armed) {
 
 void JsonlWriter::summary(const RunSummary& s) {
   out_ << "{\"type\":\"summary\",\"samples\":" << s.samples << ",\"rejected\":" << s.rejected
-       << ",\"duplicates\":" << s.duplicates << ",\"events\":" << s.events
-       << ",\"raised\":{\"accelerometer\":" << s.raised[0] << ",\"gyro\":" << s.raised[1]
-       << ",\"unknown\":" << s.raised[2] << "},\"final_a\":" << array4(s.final_a)
-       << ",\"converged\":" << boolean(s.converged) << ",\"frozen_samples\":" << s.frozen_samples
+       << ",\"duplicates\":" << s.duplicates << ",\"model_mismatches\":" << s.model_mismatches
+       << ",\"events\":" << s.events << ",\"raised\":{\"accelerometer\":" << s.raised[0]
+       << ",\"gyro\":" << s.raised[1] << ",\"unknown\":" << s.raised[2]
+       << "},\"final_a\":" << array4(s.final_a) << ",\"converged\":" << boolean(s.converged)
+       << ",\"frozen_samples\":" << s.frozen_samples
        << ",\"duration_s\":" << json_number(s.duration_s)
        << ",\"complete\":" << boolean(s.complete);
   if (!s.complete) out_ << ",\"error\":" << json_string(s.error);

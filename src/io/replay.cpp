@@ -40,6 +40,7 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
     sum.not_converged = convergence_report(engine.estimate(), cfg.identification);
   };
 
+  bool last_mismatch = false;
   Sample s;
   try {
     while (input.next(&s)) {
@@ -73,8 +74,15 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
       if (!std::isfinite(s.t)) continue;
       if (std::isnan(first_t)) first_t = s.t;
       if (std::isnan(last_t) || s.t > last_t) last_t = s.t;
+      const IsolatorStatus& iso = engine.isolation_status();
+      if (iso.model_mismatch != last_mismatch) {
+        // Model mismatch: reported, counted, never a latched sensor fault.
+        out.mismatch(s.t, iso.model_mismatch, iso.mismatch_reason);
+        last_mismatch = iso.model_mismatch;
+      }
+      sum.model_mismatches = iso.mismatches;
       const bool converged = engine.estimate().converged;
-      const bool armed = engine.isolation_status().armed;
+      const bool armed = iso.armed;
       if (std::isnan(last_record) || s.t >= last_record + options.estimate_period ||
           converged != last_converged || armed != last_armed) {
         out.estimate(s.t, engine.estimate(), armed);

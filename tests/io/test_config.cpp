@@ -85,6 +85,7 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.enter_time, q.enter_time);
   EXPECT_EQ(p.leave_time, q.leave_time);
   EXPECT_EQ(p.second_fault_time, q.second_fault_time);
+  EXPECT_EQ(p.mismatch_window, q.mismatch_window);
   EXPECT_EQ(p.resume_after_fault, q.resume_after_fault);
   EXPECT_EQ(p.min_active_time, q.min_active_time);
   EXPECT_EQ(p.c_min, q.c_min);

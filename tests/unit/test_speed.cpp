@@ -119,3 +119,64 @@ TEST(SpeedInput, ASpeedChangeIsFollowedAndRaisesNoFault) {
 
 }  // namespace
 }  // namespace usvfdi
+
+namespace usvfdi {
+namespace {
+
+TEST(ModelMismatch, DynamicsThatChangeOnBothChannelsAreAMismatchNotASensorFault) {
+  // The isolation stage on the true model, then the vessel's dynamics change at once (A and
+  // B as at 60 % of the speed, without a speed input): both structured residuals leave
+  // their healthy range, which no single sensor fault does. The verdict is a model
+  // mismatch (status, reason, count); no sensor fault from the residuals stays raised.
+  Mat2 A0;
+  A0 << -0.5, -0.3, -0.8, -1.2;
+  const Vec2 B0(0.165, -2.19);
+  Isolator iso(IsolationParams{}, B0);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01;
+  const double dt = 0.1;
+  const auto delta = [](double t) {
+    return 0.1 * std::sin(0.21 * t) + 0.05 * std::sin(0.73 * t + 1) + 0.03 * std::sin(1.3 * t);
+  };
+  Vec2 x = Vec2::Zero();
+  std::vector<Detection> out;
+  bool mismatch_seen = false;
+  for (int k = 0; k < 8000; ++k) {
+    const double t = k * dt;
+    const double s = t < 400.0 ? 1.0 : 0.6;
+    const int sub = 10;
+    const double h = dt / sub;
+    for (int j = 0; j < sub; ++j) {  // Euler substeps suffice for this purpose
+      const double tt = t + j * h;
+      x += h * (s * A0 * x + s * s * B0 * delta(tt));
+    }
+    const Sample smp{t + dt, x(0) + 0.01 * n01(rng), x(1) + 0.0005 * n01(rng), delta(t + dt)};
+    iso.update(smp, &out);
+    if (k == 0) {
+      Estimate est;
+      est.A = A0;
+      est.converged = true;
+      iso.set_estimate(est);
+    }
+    if (t < 400.0) {
+      ASSERT_TRUE(out.empty()) << "healthy: " << out.front().message;
+    }
+    mismatch_seen = mismatch_seen || iso.status().model_mismatch;
+    if (iso.status().model_mismatch) {
+      EXPECT_FALSE(iso.status().mismatch_reason.empty());
+    }
+  }
+  EXPECT_TRUE(mismatch_seen);
+  EXPECT_GE(iso.status().mismatches, 1u);
+  // Every residual raise after the change was withdrawn as the mismatch it was.
+  int raised = 0, withdrawn = 0;
+  for (const Detection& d : out) {
+    if (d.sensor == Sensor::kUnknown) ADD_FAILURE() << "an unknown-sensor fault: " << d.message;
+    if (d.active && !d.update) ++raised;
+    if (!d.active && d.message.find("withdrawn: model mismatch") != std::string::npos) ++withdrawn;
+  }
+  EXPECT_EQ(raised, withdrawn);
+}
+
+}  // namespace
+}  // namespace usvfdi

@@ -56,6 +56,13 @@ struct IsolationParams {
   /// in force cannot be renewed without healthy data, so its model mismatch (largest in
   /// turns, for about a second) grows as the estimate it was made from ages [s].
   double second_fault_time = 2.0;
+  /// Model mismatch, not a sensor fault: residuals on both channels at once (C_i singles
+  /// out neither), or the other channel's structured residual rising within this long of a
+  /// raise (it is blind to the raised sensor's fault: the raise is withdrawn). Reported in
+  /// IsolatorStatus (model_mismatch, mismatch_reason, mismatches), never latched;
+  /// identification goes on learning, and detection resumes once every statistic stayed
+  /// below its leave threshold for leave_time [s]
+  double mismatch_window = 10.0;
   double min_active_time = 3.0;  ///< a residual fault stays raised at least this long [s]
   double c_min = 0.8;            ///< isolation needs C_i >= c_min ...
   double c_margin = 0.3;         ///< ... and C_i - C_other >= c_margin; else sensor unknown
@@ -136,6 +143,11 @@ struct IsolatorStatus {
   Vec2 d = Vec2::Zero();  ///< latest cross residual, the fault estimate [m/s, rad/s]
   double c_a = 0.0, c_g = 0.0;
   double speed_ratio = 1.0;  ///< s = u / U0 of the last sample (1 without a speed input)
+  /// The residuals contradict the model on both channels (IsolationParams::mismatch_window):
+  /// no sensor fault is raised from the residuals while this holds.
+  bool model_mismatch = false;
+  std::string mismatch_reason;   ///< why (empty when there is none)
+  std::uint64_t mismatches = 0;  ///< verdicts of model mismatch so far
   InputHealth input;
   std::uint64_t samples = 0;
 };
@@ -254,6 +266,8 @@ class Isolator {
   bool have_prev_ = false;
   Sample prev_{};
   double t_armed_ = kNaN;
+  double mismatch_since_ = kNaN;  ///< the current model-mismatch verdict began
+  double below_mm_since_ = kNaN;  ///< ... and its statistics have been quiet since
   double settle_time_ = 0.0;
   double t_last_suspect_ = -1e300;
   double t_last_fault_ = -1e300;

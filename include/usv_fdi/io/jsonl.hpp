@@ -36,6 +36,7 @@ struct RunSummary {
   std::uint64_t samples = 0;   ///< rows read
   std::uint64_t rejected = 0;  ///< rows the engine rejected (time missing or not increasing)
   std::uint64_t rejected_no_time = 0;    ///< of them: time missing or not finite
+  std::uint64_t model_mismatches = 0;    ///< verdicts of model mismatch (never latched)
   std::uint64_t duplicates = 0;          ///< rows that repeat the previous one exactly (dropped)
   std::size_t first_duplicate_line = 0;  ///< the first of them (not in the JSON record)
   // The first rejected row (not in the JSON record; for the command's message).
@@ -61,6 +62,8 @@ class JsonlWriter {
   void event(const FaultEvent& e);
   /// t: data time of the record [s] (the estimate itself may lag by the identification delay).
   void estimate(double t, const Estimate& est, bool armed);
+  /// A model-mismatch verdict began (active, with its reason) or ended.
+  void mismatch(double t, bool active, const std::string& reason);
   void summary(const RunSummary& s);
   void flush();
 
