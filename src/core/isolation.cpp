@@ -64,6 +64,16 @@ double restart_transient(const DedicatedObserver& o, double dt, const Vec2& sigm
   return last_above < 0 ? 0.0 : (last_above + 1) * dt;
 }
 
+const IsolationParams& validated(const IsolationParams& p) {
+  p.validate();
+  return p;
+}
+
+const Vec2& finite_B(const Vec2& B) {
+  if (!B.allFinite()) throw std::invalid_argument("model.B must be finite");
+  return B;
+}
+
 }  // namespace
 
 void IsolationParams::validate() const {
@@ -113,6 +123,7 @@ void IsolationParams::validate() const {
   require(spike_count >= 1, "spike_count", spike_count, "must be >= 1");
   require(invalid_count >= 1, "invalid_count", invalid_count, "must be >= 1");
   require(classify_window > 0, "classify_window", classify_window, "must be > 0");
+  jump.validate();
 }
 
 void Isolator::Window::push(double x, std::size_t n) {
@@ -129,9 +140,11 @@ void Isolator::Window::push(double x, std::size_t n) {
 }
 
 Isolator::Isolator(const IsolationParams& params, const Vec2& B, const SpeedParams& speed)
-    : p_(params), B_(B), speed_(speed) {
-  p_.validate();
-  if (!B.allFinite()) throw std::invalid_argument("model.B must be finite");
+    : p_(validated(params)),
+      B_(finite_B(B)),
+      speed_(speed),
+      jump_{JumpCheck(p_.jump, B_(0), p_.sigma_floor_v),
+            JumpCheck(p_.jump, B_(1), p_.sigma_floor_r)} {
   scales_configured_ = p_.sigma_v > 0;
   const double pmin = std::min(p_.poles_v.cwiseAbs().minCoeff(), p_.poles_g.cwiseAbs().minCoeff());
   settle_time_ = p_.settle_time >= 0 ? p_.settle_time : 3.0 / pmin;
@@ -316,6 +329,7 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   }
   if (have_prev_ && dt > p_.stale_timeout) ++st_.input.gaps;
   sensor_checks(s, out);
+  jump_checks(s, out);
   if (st_.armed) residual_checks(s, dt, out);
 
   // Freeze identification while anything is suspect, and for resume_time after.
@@ -436,6 +450,92 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
   if ((cond_[2].sources & kInvalid) && timing_errors_.empty()) {
     set_condition(Sensor::kUnknown, kInvalid, false, FaultKind::kInvalid, s.t,
                   "sample timestamps increase again", out);
+  }
+}
+
+bool Isolator::model_live() const {
+  return st_.armed && act_.learned && !st_.settling && act_.v.ready() && act_.g.ready();
+}
+
+void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
+  const double values[2] = {s.v, s.r};
+  const double limits[2] = {p_.max_abs_v, p_.max_abs_r};
+  const double delta =
+      std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta ? s.delta : kNaN;
+  JumpVerdict verdict[2];
+  for (int c = 0; c < 2; ++c) {
+    const double y =
+        std::isfinite(values[c]) && std::abs(values[c]) <= limits[c] ? values[c] : kNaN;
+    // Learns from a channel no condition is raised on, with the rudder known.
+    const bool learn_ok =
+        !cond_[c].active && st_.input.delta_ok && (c == kV ? st_.input.v_ok : st_.input.r_ok);
+    verdict[c] = jump_[c].update(s.t, y, delta, learn_ok);
+    st_.jump_T(c) = jump_[c].statistic();
+    st_.jump_threshold(c) = jump_[c].threshold();
+    st_.noise_N(c) = jump_[c].noise_statistic();
+    st_.noise_threshold(c) = jump_[c].noise_threshold();
+  }
+  st_.jump_armed = jump_[0].armed() && jump_[1].armed();
+  // The isolation confidence of a jump: C_i on the excess evidence of both channels.
+  const Vec2 e(std::sqrt(std::max(0.0, st_.jump_T(0) / std::max(st_.jump_threshold(0), 1.0))),
+               std::sqrt(std::max(0.0, st_.jump_T(1) / std::max(st_.jump_threshold(1), 1.0))));
+  for (int c = 0; c < 2; ++c) {
+    const JumpVerdict& v = verdict[c];
+    const Sensor sensor = channel_sensor(c);
+    const char* name = c == kV ? "accelerometer channel v: " : "gyro channel r: ";
+    const auto patch = [&](std::size_t before, double onset, double stat, double thr) {
+      if (out->size() == before || !out->back().active) return;
+      Detection& d = out->back();
+      if (std::isfinite(onset)) d.onset_time = onset;
+      d.statistic = stat;
+      d.threshold = thr;
+      const Vec2 ec = stat > 0 && e.norm() > 0 ? e : (c == kV ? Vec2(1, 0) : Vec2(0, 1));
+      d.c_a = ec(0) / ec.norm();
+      d.c_g = ec(1) / ec.norm();
+    };
+    if (v.step == JumpVerdict::Change::kRaise) jump_at_[c] = s.t;
+    if (v.noise == JumpVerdict::Change::kRaise && cond_[c].active &&
+        cond_[c].kind == FaultKind::kBias && s.t - jump_at_[c] <= 2.0 * p_.jump.noise_window) {
+      // The jump raised just before was the first samples of a noise rise: one condition,
+      // its kind refined.
+      set_condition(sensor, kNoiseRise, true, FaultKind::kNoise, s.t, name + v.message, out);
+      set_condition(sensor, kJump, false, FaultKind::kBias, s.t, name + v.message, out);
+      jump_[c].release();
+      Condition& cd = cond_[c];
+      if (cd.active && cd.kind != FaultKind::kNoise) {
+        Detection d = make_detection(sensor, true, FaultKind::kNoise, s.t);
+        d.update = true;
+        d.message = std::string("kind refined from ") + to_string(cd.kind) + " to noise: " + name +
+                    v.message;
+        cd.kind = FaultKind::kNoise;
+        out->push_back(d);
+      }
+      continue;
+    }
+    if (v.step != JumpVerdict::Change::kNone) {
+      const std::size_t before = out->size();
+      set_condition(sensor, kJump, v.step == JumpVerdict::Change::kRaise, FaultKind::kBias, s.t,
+                    name + v.message, out);
+      patch(before, v.onset, st_.jump_T(c), st_.jump_threshold(c));
+    }
+    // Once the observers are live they hold a jump like any residual fault (their cross
+    // residual sees whether the offset is still there, or has gone without a jump back).
+    if ((cond_[c].sources & kJump) && model_live()) {
+      set_condition(sensor, kResidual, true, FaultKind::kBias, s.t,
+                    std::string(name) + "held by the observers", out);
+      set_condition(sensor, kJump, false, FaultKind::kBias, s.t, "", out);
+      raised_at_[c] = s.t;
+      below_since_[c] = kNaN;
+      // Its kind is refined from the residuals' shape like any other (a scale error jumps too).
+      if (cond_[c].kind == FaultKind::kBias) refine_at_[c] = s.t + 0.5 * p_.classify_window;
+      jump_[c].release();
+    }
+    if (v.noise != JumpVerdict::Change::kNone) {
+      const std::size_t before = out->size();
+      set_condition(sensor, kNoiseRise, v.noise == JumpVerdict::Change::kRaise, FaultKind::kNoise,
+                    s.t, name + v.message, out);
+      patch(before, kNaN, st_.noise_N(c), st_.noise_threshold(c));
+    }
   }
 }
 

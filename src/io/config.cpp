@@ -309,6 +309,28 @@ class Loader {
         {"invalid_count", integ(&is.invalid_count, {1, 1000000, ""})},
         {"classify_window", num(&is.classify_window, {0, kHour, "s"})},
     };
+    JumpParams& jp = is.jump;
+    const std::map<std::string, Handler> jump = {
+        {"enabled", boo(&jp.enabled)},
+        {"pre_window", num(&jp.pre_window, {0, 60, "s"})},
+        {"post_window", num(&jp.post_window, {0, 60, "s"})},
+        {"min_samples", integ(&jp.min_samples, {3, 10000, ""})},
+        {"persist_samples", integ(&jp.persist_samples, {1, 10000, ""})},
+        {"persist_time", num(&jp.persist_time, {0, 60, "s"})},
+        {"threshold", num(&jp.threshold, {1, 1e6, ""})},
+        {"noise_threshold", num(&jp.noise_threshold, {1, 1e6, ""})},
+        {"margin", num(&jp.margin, {1, 100, ""})},
+        {"noise_window", num(&jp.noise_window, {0, 60, "s"})},
+        {"learn_time", num(&jp.learn_time, {0, 24 * kHour, "s"})},
+        {"history", num(&jp.history, {10, 100 * kHour, "s"})},
+        {"scale_time", num(&jp.scale_time, {0, 24 * kHour, "s"})},
+        {"leave_time", num(&jp.leave_time, {0, kHour, "s"})},
+        {"exit_ratio", num(&jp.exit_ratio, {0, 1, ""})},
+        {"hold_max", num(&jp.hold_max, {0, 100 * kHour, "s"})},
+        {"max_gap", num(&jp.max_gap, {0, kHour, "s"})},
+        {"b_uncertainty", num(&jp.b_uncertainty, {0, 100, ""})},
+        {"rudder_lag", num(&jp.rudder_lag, {0, 60, "s"})},
+    };
     const auto sub = [this](const std::map<std::string, Handler>& h) {
       return [this, &h](const YAML::Node& n, const std::string& p) { section(n, p, h); };
     };
@@ -316,6 +338,7 @@ class Loader {
         {"model", sub(model)},
         {"identification", sub(identification)},
         {"isolation", sub(isolation)},
+        {"jump", sub(jump)},
         {"speed", sub(speed)},
         // Parsed by the DDS service (through `extra`); otherwise accepted as any mapping.
         {"service",

@@ -98,6 +98,26 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.max_abs_r, q.max_abs_r);
   EXPECT_EQ(p.max_abs_delta, q.max_abs_delta);
   EXPECT_EQ(p.spike_gate, q.spike_gate);
+  const JumpParams &j = p.jump, &k = q.jump;
+  EXPECT_EQ(j.enabled, k.enabled);
+  EXPECT_EQ(j.pre_window, k.pre_window);
+  EXPECT_EQ(j.post_window, k.post_window);
+  EXPECT_EQ(j.min_samples, k.min_samples);
+  EXPECT_EQ(j.persist_samples, k.persist_samples);
+  EXPECT_EQ(j.persist_time, k.persist_time);
+  EXPECT_EQ(j.threshold, k.threshold);
+  EXPECT_EQ(j.noise_threshold, k.noise_threshold);
+  EXPECT_EQ(j.margin, k.margin);
+  EXPECT_EQ(j.noise_window, k.noise_window);
+  EXPECT_EQ(j.learn_time, k.learn_time);
+  EXPECT_EQ(j.history, k.history);
+  EXPECT_EQ(j.scale_time, k.scale_time);
+  EXPECT_EQ(j.leave_time, k.leave_time);
+  EXPECT_EQ(j.exit_ratio, k.exit_ratio);
+  EXPECT_EQ(j.hold_max, k.hold_max);
+  EXPECT_EQ(j.max_gap, k.max_gap);
+  EXPECT_EQ(j.b_uncertainty, k.b_uncertainty);
+  EXPECT_EQ(j.rudder_lag, k.rudder_lag);
   EXPECT_EQ(p.spike_window, q.spike_window);
   EXPECT_EQ(p.spike_count, q.spike_count);
   EXPECT_EQ(p.invalid_count, q.invalid_count);
@@ -131,6 +151,7 @@ TEST(Config, ShippedVesselConfigsMatchTheVesselModels) {
 
 TEST(Config, PaperYamlSelectsThePapersEstimator) {
   const EngineConfig c = load_engine_config(kSource + "/config/paper.yaml");
+  EXPECT_FALSE(c.isolation.jump.enabled);  // the paper detects with its observers alone
   EXPECT_EQ(c.identification.method, IdentMethod::kPaper);
   EXPECT_EQ(c.identification.eps1, 100.0);
   EXPECT_EQ(c.identification.eps2, 200.0);
@@ -180,6 +201,13 @@ isolation:
   classify_window: 9
   second_fault_time: 3.5
   resume_after_fault: 4.5
+jump:
+  enabled: false
+  pre_window: 2
+  persist_time: 0.2
+  margin: 3
+  hold_max: 45
+  rudder_lag: 0.1
 service:
   domain_id: 7
   mmsi: 257000000
@@ -210,6 +238,18 @@ service:
   EXPECT_EQ(c.identification.guard_recent_time, 90.0);
   EXPECT_EQ(c.isolation.second_fault_time, 3.5);
   EXPECT_EQ(c.isolation.resume_after_fault, 4.5);
+  EXPECT_FALSE(c.isolation.jump.enabled);
+  EXPECT_EQ(c.isolation.jump.pre_window, 2.0);
+  EXPECT_EQ(c.isolation.jump.persist_time, 0.2);
+  EXPECT_EQ(c.isolation.jump.margin, 3.0);
+  EXPECT_EQ(c.isolation.jump.hold_max, 45.0);
+  EXPECT_EQ(c.isolation.jump.rudder_lag, 0.1);
+}
+
+TEST(ConfigError, AJumpCheckKeyOutOfItsRangeIsNamed) {
+  const std::string m =
+      error_of("model:\n  B: [1, 2]\njump:\n  post_window: 0.5\n  persist_time: 0.8\n");
+  EXPECT_MENTIONS(m, "jump.persist_time", "0.8", "post_window");
 }
 
 TEST(ConfigError, UnknownKeyNamesFileKeyLineAndValue) {

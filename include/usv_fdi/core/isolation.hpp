@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "usv_fdi/core/identification.hpp"
+#include "usv_fdi/core/jump_check.hpp"
 #include "usv_fdi/core/observer.hpp"
 #include "usv_fdi/core/speed.hpp"
 #include "usv_fdi/core/types.hpp"
@@ -91,6 +92,9 @@ struct IsolationParams {
   int spike_count = 3;             ///< this many spikes in the window raise a spikes fault
   int invalid_count = 3;           ///< this many invalid values in spike_window raise invalid
   double classify_window = 8.0;    ///< history used to name the kind of a fault [s]
+  /// The model-free jump check of each channel (core/jump_check.hpp): sudden offsets and
+  /// noise rises, armed after its learn_time whether or not A is known.
+  JumpParams jump;
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
@@ -150,6 +154,10 @@ struct IsolatorStatus {
   std::uint64_t mismatches = 0;  ///< verdicts of model mismatch so far
   InputHealth input;
   std::uint64_t samples = 0;
+  /// The jump check per channel [accelerometer, gyro] (core/jump_check.hpp).
+  bool jump_armed = false;
+  Vec2 jump_T = Vec2::Zero(), jump_threshold = Vec2::Zero();    ///< step statistic
+  Vec2 noise_N = Vec2::Zero(), noise_threshold = Vec2::Zero();  ///< noise statistic
 };
 
 class Isolator {
@@ -190,7 +198,15 @@ class Isolator {
     unsigned sources = 0;  ///< bitmask of Source
     FaultKind kind = FaultKind::kUnknown;
   };
-  enum Source : unsigned { kResidual = 1u, kStale = 2u, kStuck = 4u, kSpikes = 8u, kInvalid = 16u };
+  enum Source : unsigned {
+    kResidual = 1u,
+    kStale = 2u,
+    kStuck = 4u,
+    kSpikes = 8u,
+    kInvalid = 16u,
+    kJump = 32u,       ///< the jump check: a sudden offset
+    kNoiseRise = 64u,  ///< the jump check: a rise of the noise
+  };
   struct Channel {
     double last_valid_t = kNaN;
     double last_value = kNaN;
@@ -245,6 +261,10 @@ class Isolator {
                      const std::string& message, std::vector<Detection>* out);
   Detection make_detection(Sensor sensor, bool active, FaultKind kind, double t) const;
   void sensor_checks(const Sample& s, std::vector<Detection>* out);
+  /// The jump check of both channels (model-free: runs armed or not).
+  void jump_checks(const Sample& s, std::vector<Detection>* out);
+  /// The observers are designed, settled and have learned their statistics.
+  bool model_live() const;
   void residual_checks(const Sample& s, double dt, std::vector<Detection>* out);
   FaultKind classify(int ch) const;
   FaultKind classify_shape(int ch) const;
@@ -278,6 +298,8 @@ class Isolator {
   std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
   std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
   std::array<Channel, 3> ch_;                                    ///< v, r, delta
+  std::array<JumpCheck, 2> jump_;                                ///< v, r
+  std::array<double, 2> jump_at_{kNaN, kNaN};  ///< time of each channel's last jump raise
   std::deque<double> timing_errors_;  ///< times of repeated / backward stamps (unknown sensor)
   std::array<Condition, 3> cond_;     ///< accelerometer, gyro, unknown
   std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown

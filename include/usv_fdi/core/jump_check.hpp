@@ -1,0 +1,168 @@
+// The jump check: a model-free test of one INS channel for the faults that break the
+// smoothness of a vessel's motion, a sudden offset (bias) and a rise of the noise, armed
+// after a minute of data whether or not A has been identified. docs/design.md section 8.6.
+//
+// A hull's sway velocity and yaw rate are integrals of forces, so they are continuous; the
+// rudder's part of their slope is known from B: z = y - b * int(delta dt) removes it. A
+// sensor offset of size f at sample k0 shows as a level step in z. A B that is off, or a
+// lagging rudder sensor, leave part of the rudder's effect in z: the step test discounts
+// |b| (b_uncertainty |f_m(int delta)| + rudder_lag |f_m(delta)|), what they could make of
+// the same window. At every sample k and
+// for every onset k0 = k - m (m = persist - 1 .. M - 1) a straight line is fitted to the L
+// samples before k0 and extrapolated over the post window [k0, k]:
+//   f_m = mean(z over [k0, k]) - mean(line over [k0, k]),   T_m = f_m^2 / (sigma^2 c_m),
+// c_m = 1/(m+1) + 1/L + (m/2 - jbar)^2 / S_jj the variance factor of f_m for white noise
+// of scale sigma (jbar, S_jj the mean and the sum of squares of the pre window's indices
+// about it), sigma learned as the scale of the one-step innovation e = f_0 / sqrt(c_0).
+// T = max_m T_m is tested against max(threshold, margin x the largest T of the healthy
+// past), so waves, manoeuvres and coloured noise raise the bar the check has to clear on
+// this hull in this sea, and a jump that is only one or two samples long (an outlier) is
+// refused: the post samples must deviate in the step's direction by half of it, at least
+// persist of them, with a spread about the new level below half of it. The noise test is
+// the mean square of the second differences of z over noise_window without their three
+// largest (a step moves two of them, an outlier three), relative to its healthy mean,
+// against max(noise_threshold, margin x its healthy maximum).
+//
+// A raised jump holds until a jump back (of the opposite sign and at least half the offset
+// so far; a jump of the same sign, or a smaller one back, adds to the offset), or hold_max. Samples
+// are taken as equally spaced at the learned interval: one or a few dropped samples are filled by
+// linear interpolation, a gap longer than max_gap restarts the windows.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "usv_fdi/core/types.hpp"
+
+namespace usvfdi {
+
+struct JumpParams {
+  bool enabled = true;           ///< false: the check never raises
+  double pre_window = 1.0;       ///< line fitted before a candidate onset [s]
+  double post_window = 0.5;      ///< longest time after the onset that is tested [s]
+  int min_samples = 5;           ///< each window holds at least this many samples
+  int persist_samples = 3;       ///< a jump must last this many samples (else an outlier)
+  double persist_time = 0.3;     ///< ... and this long (a burst of noise is not a jump) [s]
+  double threshold = 30.0;       ///< floor of the step statistic's threshold [-]
+  double noise_threshold = 4.0;  ///< floor of the noise statistic's threshold [-]
+  double margin = 2.0;           ///< thresholds >= margin x the healthy maximum [-]
+  double noise_window = 1.0;     ///< mean square of the innovations over this [s]
+  double learn_time = 60.0;      ///< healthy data before the check is armed [s]
+  double history = 600.0;        ///< the healthy maximum is that of this long [s]
+  double scale_time = 30.0;      ///< averaging time of the innovation scale [s]
+  double leave_time = 1.0;       ///< a noise rise clears after this long below [s]
+  double exit_ratio = 0.5;       ///< ... below exit_ratio x its threshold [-]
+  double hold_max = 30.0;        ///< a jump with no jump back is held this long [s]
+  double max_gap = 0.5;          ///< a longer gap between samples restarts the windows [s]
+  /// The rudder's part of z is known only so well: B may be off by this much (relative) and
+  /// the rudder sensor may lag by rudder_lag; a step is only what these cannot explain [-]
+  double b_uncertainty = 0.5;
+  double rudder_lag = 0.3;  ///< [s]
+
+  /// Throws std::invalid_argument naming the offending field.
+  void validate() const;
+};
+
+/// What the check found on one sample.
+struct JumpVerdict {
+  enum class Change : std::uint8_t { kNone = 0, kRaise, kClear };
+  Change step = Change::kNone;   ///< a jump raised, or cleared by a jump back / hold_max
+  Change noise = Change::kNone;  ///< a noise rise raised or cleared
+  double onset = kNaN;           ///< the raised jump's first sample [s]
+  double size = kNaN;            ///< its size [channel unit]
+  std::string message;
+};
+
+/// The jump check of one channel (y = v or r, b = B's entry of that channel).
+class JumpCheck {
+ public:
+  /// sigma_floor: the smallest scale of the innovations [channel unit].
+  JumpCheck(const JumpParams& p, double b, double sigma_floor);
+
+  /// One sample (y and delta NaN when unusable). learn_ok: the channel is healthy as far
+  /// as the caller knows (its statistics and thresholds may learn from this sample).
+  JumpVerdict update(double t, double y, double delta, bool learn_ok);
+
+  /// Forgets a raised jump (another detector holds the fault from now on): the next jump
+  /// of either sign is a new one.
+  void release() {
+    raised_ = false;
+    offset_ = 0.0;
+  }
+
+  bool armed() const { return armed_; }
+  bool jump_raised() const { return raised_; }
+  bool noise_raised() const { return noise_raised_; }
+  double statistic() const { return T_; }          ///< max_m T_m of the last sample
+  double threshold() const { return threshold_; }  ///< in force (0 before arming)
+  double noise_statistic() const { return N_; }
+  double noise_threshold() const { return noise_threshold_; }
+  double scale() const { return sigma_; }  ///< innovation scale [channel unit]
+  double interval() const { return dt_; }  ///< learned sample interval [s]
+
+ private:
+  JumpVerdict decide(double t, double y, double delta, bool learn_ok);
+  void restart();
+  struct Prefix {
+    std::vector<double> p0, p1;  ///< prefix sums of x and j x in logical order
+  };
+  void push(double t, double z, double I, double delta);
+  /// The step estimate f_m of a series (its prefix sums).
+  double step_of(const Prefix& q, int m) const;
+  void resize_windows();
+  /// Step statistic at onset m samples back; fills *f.
+  double step_stat(int m, double* f) const;
+  bool persists(int m, double f) const;
+  /// Learns from a sample once it is `M` samples old and no jump or noise rise was found
+  /// since (the first samples of a fault come before its detection).
+  void learn(double t, double T, double N, double e2, double d2sq, bool learn_ok);
+  struct Pending {
+    double t, T, N, e2, d2sq;
+    bool ok;
+  };
+  double healthy_max(const std::vector<double>& blocks, double current) const;
+
+  JumpParams p_;
+  double b_;
+  double floor_;
+  // Equally spaced samples (oldest first in the ring).
+  std::vector<double> z_;   ///< ring of z values
+  std::vector<double> i_;   ///< ring of int(delta dt) [rad s]
+  std::vector<double> d_;   ///< ring of delta [rad]
+  std::vector<double> ts_;  ///< their times
+  std::size_t head_ = 0;    ///< index of the oldest
+  std::size_t n_ = 0;       ///< samples held
+  int L_ = 0, M_ = 0;       ///< pre window, longest post window [samples]
+  int persist_ = 1;         ///< samples a jump must last
+  double dt_ = 0.0;         ///< learned interval [s]
+  int dt_seen_ = 0;
+  double last_t_ = kNaN, last_z_ = kNaN, last_I_ = kNaN, last_d_ = kNaN;
+  double I_ = 0.0;  ///< int delta dt since the restart [rad s]
+  double last_delta_ = kNaN;
+  Prefix pz_, pi_, pd_;  ///< scratch: prefix sums of z, int(delta), delta
+  // Learning.
+  double sigma_ = 0.0;
+  double sigma_seen_ = 0.0;
+  double learned_ = 0.0;  ///< healthy time seen [s]
+  bool armed_ = false;
+  std::vector<double> blocks_T_, blocks_N_;  ///< maxima of completed blocks (a ring)
+  std::size_t block_next_ = 0;
+  double block_start_ = kNaN, block_T_ = 0.0, block_N_ = 0.0;
+  std::vector<Pending> pending_;  ///< samples not yet learned from (oldest first)
+  std::vector<double> d2_;        ///< ring of the last squared second differences (noise window)
+  std::size_t d2_next_ = 0, d2_n_ = 0;
+  double sigma2_ = 0.0;  ///< scale of the second differences [channel unit]
+  // Verdicts.
+  double T_ = 0.0, N_ = 0.0;
+  double threshold_ = 0.0, noise_threshold_ = 0.0;
+  bool raised_ = false;
+  bool step_reported_ = false, noise_reported_ = false;  ///< their raise was reported
+  double offset_ = 0.0;  ///< the offset since the raise (the jumps added up)
+  double raised_at_ = kNaN;
+  bool noise_raised_ = false;
+  double noise_below_since_ = kNaN;
+};
+
+}  // namespace usvfdi

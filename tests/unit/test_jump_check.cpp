@@ -1,0 +1,249 @@
+// The jump check (core/jump_check.hpp, docs/design.md section 8.6): a model-free test of one
+// INS channel for sudden offsets and noise rises.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "usv_fdi/core/engine.hpp"
+#include "usv_fdi/core/jump_check.hpp"
+#include "usv_fdi/core/simulator.hpp"
+#include "usv_fdi/core/vessel.hpp"
+
+namespace usvfdi {
+namespace {
+
+constexpr double kSigma = 0.01;  // white noise of the channel [m/s]
+constexpr double kB = 0.2;       // B's entry of the channel [m/s^2/rad]
+
+/// A channel that moves like a hull's: a slow swing, the rudder's part b int(delta) (the
+/// rudder a sine of 10 deg, 40 s), white noise. extra(t, k) is added to the measurement.
+struct Channel {
+  double rate = 10.0;
+  double b_true = kB;  ///< the rudder's true effect (the check is given kB)
+  double lag = 0.0;    ///< rudder sensor lag [s]
+  std::uint64_t seed = 1;
+};
+
+struct Row {
+  double t, y, delta;
+};
+
+template <typename Extra>
+std::vector<Row> channel(const Channel& c, double duration, Extra extra) {
+  std::mt19937_64 rng(c.seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::vector<Row> rows;
+  const double dt = 1.0 / c.rate;
+  double I = 0.0, delta_prev = 0.0;
+  for (long k = 0; k * dt <= duration; ++k) {
+    const double t = k * dt;
+    const double delta = 0.17 * std::sin(2.0 * M_PI * t / 40.0);
+    I += 0.5 * (delta + delta_prev) * dt;
+    delta_prev = delta;
+    // The sensor reports the rudder as it was `lag` seconds ago.
+    const double seen = 0.17 * std::sin(2.0 * M_PI * (t - c.lag) / 40.0);
+    const double y = 0.3 * std::sin(2.0 * M_PI * t / 300.0) + c.b_true * I + kSigma * n01(rng);
+    rows.push_back({t, y + extra(t, k), seen});
+  }
+  return rows;
+}
+
+struct Seen {
+  std::vector<JumpVerdict> steps, noises;
+  std::vector<double> step_t, noise_t;
+};
+
+Seen run_check(const std::vector<Row>& rows, const JumpParams& p = {}) {
+  JumpCheck check(p, kB, 1e-4);
+  Seen s;
+  for (const Row& r : rows) {
+    const JumpVerdict v = check.update(r.t, r.y, r.delta, !check.jump_raised());
+    if (v.step != JumpVerdict::Change::kNone) {
+      s.steps.push_back(v);
+      s.step_t.push_back(r.t);
+    }
+    if (v.noise != JumpVerdict::Change::kNone) {
+      s.noises.push_back(v);
+      s.noise_t.push_back(r.t);
+    }
+  }
+  return s;
+}
+
+TEST(JumpCheck, ATenSigmaOffsetIsRaisedWithinHalfASecondAndClearedByTheJumpBack) {
+  for (double rate : {10.0, 50.0}) {
+    SCOPED_TRACE(rate);
+    // GIVEN a moving channel with a 10 sigma offset on [100, 120) s
+    Channel c;
+    c.rate = rate;
+    const auto rows = channel(
+        c, 200.0, [](double t, long) { return t >= 100.0 && t < 120.0 ? 10.0 * kSigma : 0.0; });
+    // WHEN the check runs
+    const Seen s = run_check(rows);
+    // THEN it raises once, within 0.5 s, with the onset and the size, and clears at the end
+    ASSERT_EQ(s.steps.size(), 2u);
+    EXPECT_EQ(s.steps[0].step, JumpVerdict::Change::kRaise);
+    EXPECT_GE(s.step_t[0], 100.0);
+    EXPECT_LE(s.step_t[0], 100.5);
+    EXPECT_NEAR(s.steps[0].onset, 100.0, 1.5 / rate);
+    EXPECT_NEAR(s.steps[0].size, 10.0 * kSigma, 3.0 * kSigma);
+    EXPECT_EQ(s.steps[1].step, JumpVerdict::Change::kClear);
+    EXPECT_GE(s.step_t[1], 120.0);
+    EXPECT_LE(s.step_t[1], 120.5);
+    EXPECT_TRUE(s.noises.empty());
+  }
+}
+
+TEST(JumpCheck, ANoiseRiseIsANoiseRiseNotAJump) {
+  for (double rate : {10.0, 50.0}) {
+    SCOPED_TRACE(rate);
+    // GIVEN noise x8 on [100, 130) s
+    Channel c;
+    c.rate = rate;
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    const auto rows = channel(c, 200.0, [&](double t, long) {
+      return t >= 100.0 && t < 130.0 ? std::sqrt(63.0) * kSigma * n01(rng) : 0.0;
+    });
+    const Seen s = run_check(rows);
+    // THEN the noise rise is raised within 1.5 s and cleared after it ends
+    ASSERT_EQ(s.noises.size(), 2u);
+    EXPECT_EQ(s.noises[0].noise, JumpVerdict::Change::kRaise);
+    EXPECT_GE(s.noise_t[0], 100.0);
+    EXPECT_LE(s.noise_t[0], 101.5);
+    EXPECT_EQ(s.noises[1].noise, JumpVerdict::Change::kClear);
+    EXPECT_GE(s.noise_t[1], 130.0);
+    EXPECT_LE(s.noise_t[1], 133.0);
+    // AND a jump, if one was seen in its first samples, came just before it
+    for (double t : s.step_t) {
+      EXPECT_GE(t, 100.0);
+      EXPECT_LE(t, s.noise_t[0]);
+    }
+  }
+}
+
+TEST(JumpCheck, OutliersAreNeitherJumpsNorNoise) {
+  // GIVEN single-sample outliers of 30 sigma every 5 s
+  Channel c;
+  const auto rows = channel(
+      c, 400.0, [](double t, long k) { return t > 80.0 && k % 50 == 0 ? 30.0 * kSigma : 0.0; });
+  const Seen s = run_check(rows);
+  EXPECT_TRUE(s.steps.empty());
+  EXPECT_TRUE(s.noises.empty());
+}
+
+TEST(JumpCheck, AnHourOfHealthyDataWithAWrongBAndALaggingRudderRaisesNothing) {
+  for (double rate : {10.0, 50.0}) {
+    SCOPED_TRACE(rate);
+    // GIVEN B off by 30 % and a rudder sensor 0.2 s late, and the rudder swinging faster:
+    // the rudder's part of z is not removed exactly
+    Channel c;
+    c.rate = rate;
+    c.b_true = 1.3 * kB;
+    c.lag = 0.2;
+    c.seed = 3;
+    const auto rows = channel(c, 3600.0, [](double, long) { return 0.0; });
+    const Seen s = run_check(rows);
+    EXPECT_TRUE(s.steps.empty());
+    EXPECT_TRUE(s.noises.empty());
+  }
+}
+
+TEST(JumpCheck, DroppedSamplesAreFilledAndALongGapRestartsTheWindows) {
+  // GIVEN 2 % of the samples dropped, a gap of 3 s at 150 s, and an offset at 250 s
+  Channel c;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  auto rows = channel(c, 300.0, [](double t, long) { return t >= 250.0 ? 10.0 * kSigma : 0.0; });
+  std::vector<Row> kept;
+  for (const Row& r : rows) {
+    if ((r.t >= 150.0 && r.t < 153.0) || u01(rng) < 0.02) continue;
+    kept.push_back(r);
+  }
+  const Seen s = run_check(kept);
+  // THEN the offset is the only thing raised (and held for hold_max, to 280 s)
+  ASSERT_EQ(s.steps.size(), 2u);
+  EXPECT_EQ(s.steps[0].step, JumpVerdict::Change::kRaise);
+  EXPECT_NEAR(s.step_t[1], s.step_t[0] + JumpParams{}.hold_max, 0.2);
+  EXPECT_GE(s.step_t[0], 250.0);
+  EXPECT_LE(s.step_t[0], 250.7);
+  EXPECT_TRUE(s.noises.empty());
+}
+
+TEST(JumpCheck, NothingIsRaisedBeforeLearnTimeAndAnUnreturnedJumpIsHeldForHoldMax) {
+  // GIVEN an offset on [40, 50) s, before the check has learned for learn_time, and one
+  // from 100 s on
+  Channel c;
+  const auto rows = channel(c, 200.0, [](double t, long) {
+    return (t >= 40.0 && t < 50.0) || t >= 100.0 ? 10.0 * kSigma : 0.0;
+  });
+  JumpParams p;
+  const Seen s = run_check(rows, p);
+  // THEN the first is not raised (nor its end taken for a new one, nor learned as healthy);
+  // the second is, and it clears after hold_max without a jump back
+  ASSERT_EQ(s.steps.size(), 2u);
+  EXPECT_GE(s.step_t[0], 100.0);
+  EXPECT_LE(s.step_t[0], 100.5);
+  EXPECT_EQ(s.steps[1].step, JumpVerdict::Change::kClear);
+  EXPECT_NEAR(s.step_t[1], s.step_t[0] + p.hold_max, 0.2);
+}
+
+TEST(JumpCheck, BadParametersNameTheKey) {
+  JumpParams p;
+  p.persist_time = 1.0;  // longer than post_window
+  try {
+    JumpCheck check(p, kB, 1e-4);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("jump.persist_time"), std::string::npos) << e.what();
+  }
+  p = JumpParams{};
+  p.margin = 0.5;
+  EXPECT_THROW(JumpCheck(p, kB, 1e-4), std::invalid_argument);
+  EXPECT_THROW(JumpCheck(JumpParams{}, kNaN, 1e-4), std::invalid_argument);
+}
+
+TEST(JumpCheckInEngine, AnOffsetIsRaisedAndIsolatedLongBeforeIdentificationConverges) {
+  // GIVEN the Mariner at 10 Hz (identification converges after several minutes), with a
+  // 10 sigma accelerometer bias on [150, 180) s and a gyro one on [210, 240) s
+  VesselModel v;
+  ASSERT_TRUE(find_vessel("mariner", &v));
+  SimConfig sim;
+  sim.vessel = v;
+  sim.rate_hz = 10.0;
+  sim.duration = 260.0;
+  sim.seed = 4;
+  sim.faults = {{Sensor::kAccelerometer, FaultKind::kBias, 150.0, 180.0, 10.0 * v.sigma_v},
+                {Sensor::kGyro, FaultKind::kBias, 210.0, 240.0, 10.0 * v.sigma_r}};
+  EngineConfig cfg;
+  cfg.B = v.B;
+  FdiEngine engine(cfg);
+  std::vector<FaultEvent> events;
+  std::vector<FaultEvent> raises;
+  for (const SimRow& r : simulate(sim)) {
+    events.clear();
+    engine.process({r.t, r.v, r.r, r.delta}, &events);
+    for (const FaultEvent& e : events) {
+      if (e.state == FaultState::kRaised) raises.push_back(e);
+    }
+  }
+  // THEN both are raised within 0.5 s, each on its own sensor, while A is still unknown
+  EXPECT_FALSE(engine.isolation_status().armed);
+  ASSERT_EQ(raises.size(), 2u);
+  EXPECT_EQ(raises[0].sensor, Sensor::kAccelerometer);
+  EXPECT_GE(raises[0].t, 150.0);
+  EXPECT_LE(raises[0].t, 150.5);
+  EXPECT_GT(raises[0].c_a, 0.8);
+  EXPECT_EQ(raises[1].sensor, Sensor::kGyro);
+  EXPECT_GE(raises[1].t, 210.0);
+  EXPECT_LE(raises[1].t, 210.5);
+  EXPECT_GT(raises[1].c_g, 0.8);
+  for (const FaultEvent& e : raises) EXPECT_EQ(e.kind, FaultKind::kBias);
+}
+
+}  // namespace
+}  // namespace usvfdi
