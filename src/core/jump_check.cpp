@@ -17,7 +17,11 @@ void require(bool ok, const char* field, double value, const char* what) {
 
 constexpr double kBlock = 10.0;       ///< length of a block of the healthy maxima [s]
 constexpr int kIntervalSamples = 11;  ///< samples whose median interval sets dt
-constexpr double kRebase = 100.0;     ///< re-base int(delta) beyond this [rad s]
+constexpr double kRebase = 1e4;       ///< restart the windows when int(delta) grows beyond [rad s]
+constexpr int kExact = 128;           ///< sliding sums are recomputed exactly this often
+/// Below this fraction of the threshold's floor a step statistic needs no discount for the
+/// rudder (it cannot matter): most samples skip that work.
+constexpr double kDiscountFrom = 0.25;
 
 }  // namespace
 
@@ -44,6 +48,76 @@ void JumpParams::validate() const {
   require(rudder_lag >= 0, "rudder_lag", rudder_lag, "must be >= 0");
 }
 
+// ------------------------------------------------------------------------------ Series
+
+void JumpCheck::Series::reset(int L, int M) {
+  L_ = L;
+  M_ = M;
+  cap_ = L + M + 1;
+  x_.assign(static_cast<std::size_t>(cap_), 0.0);
+  mean_.assign(x_.size(), 0.0);
+  slope_.assign(x_.size(), 0.0);
+  clear();
+}
+
+void JumpCheck::Series::clear() {
+  newest_ = -1;
+  count_ = 0;
+  S0_ = S1_ = 0.0;
+  since_exact_ = 0;
+}
+
+void JumpCheck::Series::push(double x) {
+  newest_ = newest_ + 1 == cap_ ? 0 : newest_ + 1;
+  x_[static_cast<std::size_t>(newest_)] = x;
+  if (count_ >= L_) {
+    const double out = at(L_);  // leaves the window of the newest L
+    S1_ += -(S0_ - out) + (L_ - 1) * x;
+    S0_ += x - out;
+  } else {
+    S1_ += count_ * x;
+    S0_ += x;
+  }
+  ++count_;
+  if (count_ < L_) return;
+  if (++since_exact_ >= kExact) {  // bound the round-off of the sliding sums
+    since_exact_ = 0;
+    S0_ = S1_ = 0.0;
+    for (int j = 0; j < L_; ++j) {
+      const double v = at(L_ - 1 - j);
+      S0_ += v;
+      S1_ += j * v;
+    }
+  }
+  const double jbar = 0.5 * (L_ - 1);
+  const double Sjj = L_ * (static_cast<double>(L_) * L_ - 1.0) / 12.0;
+  mean_[static_cast<std::size_t>(newest_)] = S0_ / L_;
+  slope_[static_cast<std::size_t>(newest_)] = (S1_ - jbar * S0_) / Sjj;
+}
+
+void JumpCheck::Series::steps(int m_hi, double* f) const {
+  // Walks back from the newest sample (and the fit before it) without a modulo per step.
+  int k = newest_, kf = newest_ == 0 ? cap_ - 1 : newest_ - 1;
+  double post = 0.0;
+  for (int m = 0; m <= m_hi; ++m) {
+    post += x_[static_cast<std::size_t>(k)];
+    const double lever = 0.5 * (L_ + 1) + 0.5 * m;  // post positions' mean - pre window's
+    f[m] = post / (m + 1) -
+           (mean_[static_cast<std::size_t>(kf)] + slope_[static_cast<std::size_t>(kf)] * lever);
+    k = kf;
+    kf = kf == 0 ? cap_ - 1 : kf - 1;
+  }
+}
+
+double JumpCheck::Series::line(int m, int back) const {
+  const auto k = static_cast<std::size_t>((newest_ + cap_ - (m + 1)) % cap_);
+  // Local index in the fit's window (0 its oldest, L - 1 its newest).
+  const double j = (L_ - 1) + (m + 1 - back);
+  return mean_[k] + slope_[k] * (j - 0.5 * (L_ - 1));
+}
+
+// --------------------------------------------------------------------------- JumpCheck
+
 JumpCheck::JumpCheck(const JumpParams& p, double b, double sigma_floor)
     : p_(p), b_(b), floor_(sigma_floor) {
   p_.validate();
@@ -54,115 +128,149 @@ JumpCheck::JumpCheck(const JumpParams& p, double b, double sigma_floor)
   blocks_N_.assign(blocks, 0.0);
 }
 
-void JumpCheck::restart() {
-  head_ = 0;
-  n_ = 0;
-  I_ = 0.0;
-  last_t_ = kNaN;
-  last_z_ = kNaN;
-  last_I_ = kNaN;
-  last_d_ = kNaN;
-  d2_n_ = 0;
-  d2_next_ = 0;
-}
-
 void JumpCheck::resize_windows() {
   L_ = std::max(p_.min_samples, static_cast<int>(std::lround(p_.pre_window / dt_)));
   M_ = std::max(p_.min_samples, static_cast<int>(std::lround(p_.post_window / dt_)));
   persist_ = std::min(
       M_, std::max(p_.persist_samples, static_cast<int>(std::lround(p_.persist_time / dt_)) + 1));
-  const auto cap = static_cast<std::size_t>(L_ + M_);
-  z_.assign(cap, 0.0);
-  i_.assign(cap, 0.0);
-  d_.assign(cap, 0.0);
-  ts_.assign(cap, 0.0);
-  for (Prefix* q : {&pz_, &pi_, &pd_}) {
-    q->p0.assign(cap + 1, 0.0);
-    q->p1.assign(cap + 1, 0.0);
+  for (Series* s : {&z_, &i_, &d_}) s->reset(L_, M_);
+  ts_.assign(static_cast<std::size_t>(L_ + M_ + 1), 0.0);
+  c_.resize(static_cast<std::size_t>(M_));
+  const double Sjj = L_ * (static_cast<double>(L_) * L_ - 1.0) / 12.0;
+  for (int m = 0; m < M_; ++m) {
+    const double lever = 0.5 * (L_ + 1) + 0.5 * m;
+    c_[static_cast<std::size_t>(m)] = 1.0 / (m + 1) + 1.0 / L_ + lever * lever / Sjj;
   }
+  inv_c_.resize(c_.size());
+  for (std::size_t m = 0; m < c_.size(); ++m) inv_c_[m] = 1.0 / c_[m];
+  f_.assign(static_cast<std::size_t>(M_), 0.0);
+  fi_ = fd_ = f_;
+  pending_.assign(static_cast<std::size_t>(M_), Pending{});
+  pending_head_ = pending_n_ = 0;
   const auto w = static_cast<std::size_t>(
       std::max<long>(2L * p_.min_samples, std::lround(p_.noise_window / dt_)));
   d2_.assign(w, 0.0);
 }
 
+void JumpCheck::restart() {
+  for (Series* s : {&z_, &i_, &d_}) s->clear();
+  I_ = 0.0;
+  last_t_ = last_z_ = last_I_ = last_d_ = kNaN;
+  d2_n_ = d2_next_ = 0;
+  d2_sum_ = 0.0;
+}
+
 void JumpCheck::push(double t, double z, double I, double delta) {
-  const std::size_t cap = z_.size();
-  const std::size_t at = (head_ + n_) % cap;
-  z_[at] = z;
-  i_[at] = I;
-  d_[at] = delta;
-  ts_[at] = t;
-  if (n_ < cap) {
-    ++n_;
-  } else {
-    head_ = (head_ + 1) % cap;
+  z_.push(z);
+  i_.push(I);
+  d_.push(delta);
+  ts_[static_cast<std::size_t>((z_.count() - 1) % static_cast<int>(ts_.size()))] = t;
+}
+
+void JumpCheck::keep_newest(int keep) {
+  std::vector<double> t(keep), z(keep), I(keep), d(keep);
+  const int cap = static_cast<int>(ts_.size());
+  for (int k = 0; k < keep; ++k) {
+    const int back = keep - 1 - k;
+    t[k] = ts_[static_cast<std::size_t>((z_.count() - 1 - back) % cap)];
+    z[k] = z_.at(back);
+    I[k] = i_.at(back);
+    d[k] = d_.at(back);
   }
+  for (Series* s : {&z_, &i_, &d_}) s->clear();
+  for (int k = 0; k < keep; ++k) push(t[k], z[k], I[k], d[k]);
 }
 
-double JumpCheck::step_of(const Prefix& q, int m) const {
-  // Logical positions 0 (oldest) .. n-1 (newest); pre window [a, b), post [b, n).
-  const int n = static_cast<int>(n_);
-  const int b = n - 1 - m, a = b - L_;
-  const double S0 = q.p0[b] - q.p0[a], S1 = q.p1[b] - q.p1[a];
-  const double jbar = 0.5 * (a + b - 1);
-  const double Sjj = L_ * (static_cast<double>(L_) * L_ - 1.0) / 12.0;
-  const double slope = (S1 - jbar * S0) / Sjj;
-  const double post_mean = (q.p0[n] - q.p0[b]) / (m + 1);
-  return post_mean - (S0 / L_ + slope * (0.5 * (b + n - 1) - jbar));
-}
-
-double JumpCheck::step_stat(int m, double* f) const {
-  const int n = static_cast<int>(n_);
-  const int b = n - 1 - m, a = b - L_;
-  const double jbar = 0.5 * (a + b - 1);
-  const double Sjj = L_ * (static_cast<double>(L_) * L_ - 1.0) / 12.0;
-  const double lever = 0.5 * (b + n - 1) - jbar;
-  *f = step_of(pz_, m);
-  // What an error of B (relative b_uncertainty) and a rudder sensor lag (rudder_lag) could
-  // make of the same window: the rudder's part of z is known only that well.
-  const double doubt = std::abs(b_) * (p_.b_uncertainty * std::abs(step_of(pi_, m)) +
-                                       p_.rudder_lag * std::abs(step_of(pd_, m)));
-  const double excess = std::max(0.0, std::abs(*f) - doubt);
-  const double c = 1.0 / (m + 1) + 1.0 / L_ + lever * lever / Sjj;
-  return excess * excess / (sigma_ * sigma_ * c);
+void JumpCheck::step_statistics(int* m_best, double* f_best) {
+  T_ = 0.0;
+  *m_best = -1;
+  *f_best = 0.0;
+  const int m_hi = std::min(M_ - 1, z_.count() - L_ - 1);
+  if (m_hi < 0) return;
+  z_.steps(m_hi, f_.data());
+  if (m_hi < persist_ - 1) return;
+  const double s2 = sigma_ * sigma_;
+  double raw = 0.0;
+  for (int m = persist_ - 1; m <= m_hi; ++m) raw = std::max(raw, f_[m] * f_[m] * inv_c_[m]);
+  raw /= s2;
+  if (raw <= kDiscountFrom * p_.threshold) {
+    T_ = raw;  // an upper bound, far below any threshold
+    return;
+  }
+  // What an error of B (b_uncertainty) and a lagging rudder sensor (rudder_lag) could make
+  // of the same windows: the rudder's part of z is known only that well.
+  i_.steps(m_hi, fi_.data());
+  d_.steps(m_hi, fd_.data());
+  for (int m = persist_ - 1; m <= m_hi; ++m) {
+    const double doubt =
+        std::abs(b_) * (p_.b_uncertainty * std::abs(fi_[m]) + p_.rudder_lag * std::abs(fd_[m]));
+    const double excess = std::max(0.0, std::abs(f_[m]) - doubt);
+    const double Tm = excess * excess / (s2 * c_[m]);
+    if (Tm > T_) {
+      T_ = Tm;
+      *f_best = f_[m];
+      *m_best = m;
+    }
+  }
 }
 
 bool JumpCheck::persists(int m, double f) const {
-  const int n = static_cast<int>(n_);
-  const int b = n - 1 - m, a = b - L_;
-  const double S0 = pz_.p0[b] - pz_.p0[a], S1 = pz_.p1[b] - pz_.p1[a];
-  const double jbar = 0.5 * (a + b - 1);
-  const double Sjj = L_ * (static_cast<double>(L_) * L_ - 1.0) / 12.0;
-  const double slope = (S1 - jbar * S0) / Sjj;
-  // The level before the onset is clean: no sample off the line by half the step (an
+  // The level before the onset is clean: no sample off its line by half the step (an
   // outlier at its end would tilt the line and fake a step the other way).
-  for (int j = a; j < b; ++j) {
-    const double dev = z_[(head_ + j) % z_.size()] - (S0 / L_ + slope * (j - jbar));
-    if (std::abs(dev) > 0.5 * std::abs(f)) return false;
+  for (int back = m + 1; back <= m + L_; ++back) {
+    if (std::abs(z_.at(back) - z_.line(m, back)) > 0.5 * std::abs(f)) return false;
   }
+  // A level that moved and stays: enough post samples off the line by half the step, in its
+  // direction, and spread about the new level by less than half of it (not a noise burst
+  // whose mean happens to be off).
   const double sign = f < 0 ? -1.0 : 1.0;
   int count = 0;
-  double spread = 0.0;  // of the post samples about the step
-  for (int j = b; j < n; ++j) {
-    const double dev = z_[(head_ + j) % z_.size()] - (S0 / L_ + slope * (j - jbar));
+  double spread = 0.0;
+  for (int back = 0; back <= m; ++back) {
+    const double dev = z_.at(back) - z_.line(m, back);
     if (sign * dev > 0.5 * std::abs(f)) ++count;
     spread += (dev - f) * (dev - f);
   }
-  // A level that moved and stays (not a noise burst whose mean happens to be off).
   return count >= persist_ && count >= 0.6 * (m + 1) &&
          std::sqrt(spread / (m + 1)) < 0.5 * std::abs(f);
 }
 
-double JumpCheck::healthy_max(const std::vector<double>& blocks, double current) const {
-  double mx = current;
-  for (double x : blocks) mx = std::max(mx, x);
-  return mx;
+void JumpCheck::noise_statistic(double d2sq) {
+  const std::size_t W = d2_.size();
+  if (d2_n_ == W) d2_sum_ -= d2_[d2_next_];
+  d2_[d2_next_] = d2sq;
+  d2_sum_ += d2sq;
+  d2_next_ = (d2_next_ + 1) % W;
+  d2_n_ = std::min(d2_n_ + 1, W);
+  if (++d2_since_exact_ >= kExact) {
+    d2_since_exact_ = 0;
+    d2_sum_ = 0.0;
+    for (std::size_t i = 0; i < d2_n_; ++i) d2_sum_ += d2_[i];
+  }
+  N_ = 0.0;
+  if (d2_n_ < W) return;
+  const double kept = static_cast<double>(W) - 3.0, s2 = sigma2_ * sigma2_;
+  const double bound = std::max(0.0, d2_sum_) / kept / s2;
+  if (bound <= kDiscountFrom * 2.0 * p_.noise_threshold) {
+    N_ = bound;  // an upper bound, far below any threshold
+    return;
+  }
+  // The mean square without the three largest (a jump moves two, an outlier three).
+  double top[3] = {0.0, 0.0, 0.0};
+  for (double x : d2_) {
+    if (x > top[2]) {
+      top[2] = x;
+      if (top[2] > top[1]) std::swap(top[1], top[2]);
+      if (top[1] > top[0]) std::swap(top[0], top[1]);
+    }
+  }
+  N_ = std::max(0.0, d2_sum_ - top[0] - top[1] - top[2]) / kept / s2;
 }
 
-void JumpCheck::learn(double t, double T, double N, double e2, double d2sq, bool learn_ok) {
-  if (!learn_ok) return;
-  // The innovation scales: the mean of the first squares, then an exponential average over
-  // scale_time of squares winsorised at 4 sigma (a fault covering a few samples barely moves it).
+void JumpCheck::learn(const Pending& s) {
+  if (!s.ok) return;
+  // The scales: the mean of the first squares, then an exponential average over
+  // scale_time of squares winsorised at 4 sigma (a fault of a few samples barely moves it).
   sigma_seen_ += 1.0;
   const double w = std::max(1.0 / sigma_seen_, std::min(1.0, dt_ / p_.scale_time));
   const auto average = [&](double* scale, double x2) {
@@ -170,22 +278,23 @@ void JumpCheck::learn(double t, double T, double N, double e2, double d2sq, bool
     const double x = sigma_seen_ > 20 ? std::min(x2, 16.0 * s2) : x2;
     *scale = std::max(std::sqrt(s2 + w * (x - s2)), floor_);
   };
-  average(&sigma_, e2);
-  average(&sigma2_, d2sq);
+  average(&sigma_, s.e2);
+  average(&sigma2_, s.d2sq);
   learned_ += dt_;
-  // Healthy maxima per block of kBlock seconds.
-  if (std::isnan(block_start_)) block_start_ = t;
-  // (once the scale has settled: the first samples' statistics say nothing of the hull)
+  // Healthy maxima per block of kBlock seconds, once the scales have settled.
+  if (std::isnan(block_start_)) block_start_ = s.t;
   if (learned_ >= 0.5 * p_.learn_time) {
-    block_T_ = std::max(block_T_, T);
-    block_N_ = std::max(block_N_, N);
+    block_T_ = std::max(block_T_, s.T);
+    block_N_ = std::max(block_N_, s.N);
   }
-  if (t - block_start_ >= kBlock) {
+  if (s.t - block_start_ >= kBlock) {
     blocks_T_[block_next_] = block_T_;
     blocks_N_[block_next_] = block_N_;
     block_next_ = (block_next_ + 1) % blocks_T_.size();
     block_T_ = block_N_ = 0.0;
-    block_start_ = t;
+    block_start_ = s.t;
+    done_T_ = *std::max_element(blocks_T_.begin(), blocks_T_.end());
+    done_N_ = *std::max_element(blocks_N_.begin(), blocks_N_.end());
   }
 }
 
@@ -228,36 +337,25 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   }
   // The sample interval, from the first samples.
   if (dt_seen_ < kIntervalSamples) {
-    if (dt_seen_ == 0) ts_.clear();
-    ts_.push_back(t);
-    ++dt_seen_;
-    if (dt_seen_ == kIntervalSamples) {
-      for (std::size_t i = 0; i + 1 < ts_.size(); ++i) ts_[i] = ts_[i + 1] - ts_[i];
-      ts_.pop_back();
-      std::nth_element(ts_.begin(), ts_.begin() + ts_.size() / 2, ts_.end());
-      dt_ = ts_[ts_.size() / 2];
-      if (!(dt_ > 0)) {
-        dt_seen_ = 0;
-        return v;
-      }
-      resize_windows();
-      restart();
-    } else {
+    first_t_.push_back(t);
+    if (++dt_seen_ < kIntervalSamples) return v;
+    std::vector<double> d(first_t_.size() - 1);
+    for (std::size_t i = 0; i < d.size(); ++i) d[i] = first_t_[i + 1] - first_t_[i];
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    dt_ = d[d.size() / 2];
+    std::vector<double>().swap(first_t_);
+    if (!(dt_ > 0)) {
+      dt_seen_ = 0;
       return v;
     }
+    resize_windows();
+    restart();
   }
-  // Re-base the rudder integral now and then (only differences within the windows count).
-  if (std::abs(I_) > kRebase) {
-    for (std::size_t i = 0; i < n_; ++i) {
-      z_[(head_ + i) % z_.size()] += b_ * I_;
-      i_[(head_ + i) % z_.size()] -= I_;
-    }
-    if (std::isfinite(last_I_)) last_I_ -= I_;
-    if (std::isfinite(last_z_)) last_z_ += b_ * I_;
-    I_ = 0.0;
+  // A long gap restarts the windows (and the rudder integral, so z is computed after), as
+  // does a rudder integral grown too large for its round-off.
+  if (std::isfinite(last_t_) && (t - last_t_ > p_.max_gap || std::abs(I_) > kRebase)) {
+    restart();
   }
-  // A long gap restarts the windows (and the rudder integral, so z is computed after).
-  if (std::isfinite(last_t_) && t - last_t_ > p_.max_gap) restart();
   const double z = y - b_ * I_;
   const double dl = std::isfinite(last_delta_) ? last_delta_ : 0.0;
   if (std::isfinite(last_t_)) {
@@ -275,89 +373,45 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   last_z_ = z;
   last_I_ = I_;
   last_d_ = dl;
+  if (z_.count() < L_ + 1 || z_.count() < 3) return v;
 
-  // Prefix sums in logical order.
-  const auto sums = [&](const std::vector<double>& x, Prefix* q) {
-    for (std::size_t i = 0; i < n_; ++i) {
-      const double xi = x[(head_ + i) % x.size()];
-      q->p0[i + 1] = q->p0[i] + xi;
-      q->p1[i + 1] = q->p1[i] + static_cast<double>(i) * xi;
-    }
-  };
-  sums(z_, &pz_);
-  sums(i_, &pi_);
-  sums(d_, &pd_);
-  const int n = static_cast<int>(n_);
-  if (n < L_ + 1 || n < 3) return v;
-  // The one-step innovation (the step test's scale).
-  double f0 = 0.0;
   if (sigma_ <= 0) sigma_ = floor_;
   if (sigma2_ <= 0) sigma2_ = floor_;
-  step_stat(0, &f0);
-  const double c0 = 1.0 + 1.0 / L_ + std::pow(0.5 * (L_ + 1), 2) / (L_ * (L_ * L_ - 1.0) / 12.0);
-  const double e2 = f0 * f0 / c0;
-  // The noise test's innovation: the second difference (a jump moves two of them only, an
-  // outlier three; the motion and the waves barely move them).
-  const auto zat = [&](int j) { return z_[(head_ + static_cast<std::size_t>(j)) % z_.size()]; };
-  const double d2 = zat(n - 1) - 2.0 * zat(n - 2) + zat(n - 3);
-  d2_[d2_next_] = d2 * d2;
-  d2_next_ = (d2_next_ + 1) % d2_.size();
-  d2_n_ = std::min(d2_n_ + 1, d2_.size());
-  // Noise statistic: their mean square without the three largest.
-  N_ = 0.0;
-  if (d2_n_ == d2_.size()) {
-    double sum = 0.0, top[3] = {0.0, 0.0, 0.0};
-    for (double x : d2_) {
-      sum += x;
-      if (x > top[2]) {
-        top[2] = x;
-        if (top[2] > top[1]) std::swap(top[1], top[2]);
-        if (top[1] > top[0]) std::swap(top[0], top[1]);
-      }
-    }
-    const double kept = static_cast<double>(d2_.size()) - 3.0;
-    N_ = (sum - top[0] - top[1] - top[2]) / kept / (sigma2_ * sigma2_);
-  }
-  // Step statistic over the onsets the windows hold.
-  T_ = 0.0;
-  double f_best = 0.0;
   int m_best = -1;
-  for (int m = persist_ - 1; m < M_ && n >= L_ + m + 1; ++m) {
-    double f = 0.0;
-    const double Tm = step_stat(m, &f);
-    if (Tm > T_) {
-      T_ = Tm;
-      f_best = f;
-      m_best = m;
-    }
-  }
+  double f_best = 0.0;
+  step_statistics(&m_best, &f_best);
+  // The innovation (the one-step prediction error) and the second difference.
+  const double e2 = f_[0] * f_[0] / c_[0];
+  const double d2 = z_.at(0) - 2.0 * z_.at(1) + z_.at(2);
+  noise_statistic(d2 * d2);
+
   // Learning trails the decisions by the post window: a fault's first samples, seen before
   // it is detected, are dropped with the detection.
-  pending_.push_back(Pending{t, T_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_});
-  const auto lag = static_cast<std::size_t>(M_);
-  if (pending_.size() > lag) {
-    const Pending& old = pending_.front();
-    learn(old.t, old.T, old.N, old.e2, old.d2sq, old.ok);
-    pending_.erase(pending_.begin());
+  const std::size_t P = pending_.size();
+  if (pending_n_ == P) {
+    learn(pending_[pending_head_]);
+    pending_head_ = (pending_head_ + 1) % P;
+    --pending_n_;
   }
+  pending_[(pending_head_ + pending_n_) % P] =
+      Pending{t, T_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_};
+  ++pending_n_;
   armed_ = p_.enabled && learned_ >= p_.learn_time;
   // Watched from half the learning on (the scales have settled), reported once armed: a
   // fault before arming is kept out of the learning, and its end is not taken for a new one.
   if (!p_.enabled || learned_ < 0.5 * p_.learn_time) return v;
-  const double cur_T = healthy_max(blocks_T_, block_T_);
-  const double cur_N = healthy_max(blocks_N_, block_N_);
-  threshold_ = std::max(p_.threshold, p_.margin * cur_T);
-  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * cur_N);
+  threshold_ = std::max(p_.threshold, p_.margin * std::max(done_T_, block_T_));
+  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * std::max(done_N_, block_N_));
 
   // Noise rise.
   if (!noise_raised_ && N_ > noise_threshold_) {
     noise_raised_ = true;
     noise_below_since_ = kNaN;
     v.noise = JumpVerdict::Change::kRaise;
-    pending_.clear();
+    pending_n_ = 0;
     char buf[160];
     std::snprintf(buf, sizeof buf, "noise: innovation mean square %.3g > %.3g (scale %.3g)", N_,
-                  noise_threshold_, sigma_);
+                  noise_threshold_, sigma2_);
     v.message = buf;
     if (raised_ && t - raised_at_ <= 2.0 * p_.noise_window) {
       raised_ = false;  // the jump raised just before was the first samples of this noise
@@ -380,9 +434,10 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   }
   // Step.
   if (m_best < 0 || !(T_ > threshold_) || !persists(m_best, f_best)) return v;
-  const double onset = ts_[(head_ + static_cast<std::size_t>(n - 1 - m_best)) % ts_.size()];
+  const int cap = static_cast<int>(ts_.size());
+  const double onset = ts_[static_cast<std::size_t>((z_.count() - 1 - m_best) % cap)];
+  pending_n_ = 0;
   char buf[200];
-  pending_.clear();
   if (!raised_) {
     raised_ = true;
     offset_ = f_best;
@@ -406,9 +461,7 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
     v.message = buf;
   }
   // The step leaves every window: keep only the samples from its onset on.
-  const auto keep = static_cast<std::size_t>(m_best + 1);
-  head_ = (head_ + n_ - keep) % z_.size();
-  n_ = keep;
+  keep_newest(m_best + 1);
   return v;
 }
 

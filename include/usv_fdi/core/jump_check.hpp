@@ -103,57 +103,82 @@ class JumpCheck {
   double interval() const { return dt_; }  ///< learned sample interval [s]
 
  private:
-  JumpVerdict decide(double t, double y, double delta, bool learn_ok);
-  void restart();
-  struct Prefix {
-    std::vector<double> p0, p1;  ///< prefix sums of x and j x in logical order
+  /// Equally spaced samples of one series in a ring, with the line fitted to the L samples
+  /// ending at each of the last M + 1 samples (sliding sums: O(1) per sample).
+  class Series {
+   public:
+    void reset(int L, int M);
+    void clear();
+    void push(double x);
+    int count() const { return count_; }  ///< samples since clear()
+    /// The value `back` samples before the newest (0: the newest).
+    double at(int back) const {
+      const int k = newest_ - back;  // back < cap_
+      return x_[static_cast<std::size_t>(k < 0 ? k + cap_ : k)];
+    }
+    /// f_m for m in [0, m_hi] (needs count() >= L + m_hi + 1): the mean of the last m + 1
+    /// samples minus that of the line fitted to the L samples before them.
+    void steps(int m_hi, double* f) const;
+    /// The line fitted before the last m + 1 samples, at `back` samples before the newest.
+    double line(int m, int back) const;
+
+   private:
+    int L_ = 0, M_ = 0, cap_ = 1;
+    std::vector<double> x_;
+    std::vector<double> mean_, slope_;  ///< fits of the L samples ending at each sample
+    int newest_ = -1, count_ = 0;
+    double S0_ = 0.0, S1_ = 0.0;  ///< sums of x and j x over the newest L (j = 0 oldest)
+    int since_exact_ = 0;
   };
-  void push(double t, double z, double I, double delta);
-  /// The step estimate f_m of a series (its prefix sums).
-  double step_of(const Prefix& q, int m) const;
-  void resize_windows();
-  /// Step statistic at onset m samples back; fills *f.
-  double step_stat(int m, double* f) const;
-  bool persists(int m, double f) const;
-  /// Learns from a sample once it is `M` samples old and no jump or noise rise was found
-  /// since (the first samples of a fault come before its detection).
-  void learn(double t, double T, double N, double e2, double d2sq, bool learn_ok);
   struct Pending {
     double t, T, N, e2, d2sq;
     bool ok;
   };
-  double healthy_max(const std::vector<double>& blocks, double current) const;
+
+  JumpVerdict decide(double t, double y, double delta, bool learn_ok);
+  void resize_windows();
+  void restart();
+  /// Keeps only the newest `keep` samples (a jump leaves every window).
+  void keep_newest(int keep);
+  void push(double t, double z, double I, double delta);
+  /// The step statistics of the samples held: T_ and the best onset (*m_best, *f_best).
+  void step_statistics(int* m_best, double* f_best);
+  bool persists(int m, double f) const;
+  void noise_statistic(double d2sq);
+  /// Learns from a sample once it is M samples old and no jump or noise rise was found
+  /// since (the first samples of a fault come before its detection).
+  void learn(const Pending& s);
 
   JumpParams p_;
   double b_;
   double floor_;
-  // Equally spaced samples (oldest first in the ring).
-  std::vector<double> z_;   ///< ring of z values
-  std::vector<double> i_;   ///< ring of int(delta dt) [rad s]
-  std::vector<double> d_;   ///< ring of delta [rad]
-  std::vector<double> ts_;  ///< their times
-  std::size_t head_ = 0;    ///< index of the oldest
-  std::size_t n_ = 0;       ///< samples held
-  int L_ = 0, M_ = 0;       ///< pre window, longest post window [samples]
-  int persist_ = 1;         ///< samples a jump must last
-  double dt_ = 0.0;         ///< learned interval [s]
+  Series z_, i_, d_;                 ///< z = y - b int(delta), int(delta) [rad s], delta [rad]
+  std::vector<double> ts_;           ///< times of the samples held (a ring like the series')
+  std::vector<double> c_, inv_c_;    ///< variance factor c_m of f_m, and 1 / c_m
+  std::vector<double> f_, fi_, fd_;  ///< scratch: f_m of z, int(delta), delta
+  int L_ = 0, M_ = 0;                ///< pre window, longest post window [samples]
+  int persist_ = 1;                  ///< samples a jump must last
+  double dt_ = 0.0;                  ///< learned interval [s]
   int dt_seen_ = 0;
+  std::vector<double> first_t_;  ///< the first samples' times (for dt)
   double last_t_ = kNaN, last_z_ = kNaN, last_I_ = kNaN, last_d_ = kNaN;
   double I_ = 0.0;  ///< int delta dt since the restart [rad s]
   double last_delta_ = kNaN;
-  Prefix pz_, pi_, pd_;  ///< scratch: prefix sums of z, int(delta), delta
   // Learning.
-  double sigma_ = 0.0;
+  double sigma_ = 0.0, sigma2_ = 0.0;  ///< scales of the innovation and the 2nd difference
   double sigma_seen_ = 0.0;
   double learned_ = 0.0;  ///< healthy time seen [s]
   bool armed_ = false;
   std::vector<double> blocks_T_, blocks_N_;  ///< maxima of completed blocks (a ring)
+  double done_T_ = 0.0, done_N_ = 0.0;       ///< the largest of them
   std::size_t block_next_ = 0;
   double block_start_ = kNaN, block_T_ = 0.0, block_N_ = 0.0;
-  std::vector<Pending> pending_;  ///< samples not yet learned from (oldest first)
-  std::vector<double> d2_;        ///< ring of the last squared second differences (noise window)
+  std::vector<Pending> pending_;  ///< samples not yet learned from (a ring, oldest first)
+  std::size_t pending_head_ = 0, pending_n_ = 0;
+  std::vector<double> d2_;  ///< ring of the last squared second differences (noise window)
   std::size_t d2_next_ = 0, d2_n_ = 0;
-  double sigma2_ = 0.0;  ///< scale of the second differences [channel unit]
+  double d2_sum_ = 0.0;
+  int d2_since_exact_ = 0;
   // Verdicts.
   double T_ = 0.0, N_ = 0.0;
   double threshold_ = 0.0, noise_threshold_ = 0.0;
