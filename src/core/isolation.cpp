@@ -123,6 +123,8 @@ void IsolationParams::validate() const {
   require(spike_count >= 1, "spike_count", spike_count, "must be >= 1");
   require(invalid_count >= 1, "invalid_count", invalid_count, "must be >= 1");
   require(classify_window > 0, "classify_window", classify_window, "must be > 0");
+  require(history_margin >= 1, "history_margin", history_margin, "must be >= 1");
+  require(history >= 10, "history", history, "must be >= 10 s");
   jump.validate();
 }
 
@@ -144,7 +146,8 @@ Isolator::Isolator(const IsolationParams& params, const Vec2& B, const SpeedPara
       B_(finite_B(B)),
       speed_(speed),
       jump_{JumpCheck(p_.jump, B_(0), p_.sigma_floor_v),
-            JumpCheck(p_.jump, B_(1), p_.sigma_floor_r)} {
+            JumpCheck(p_.jump, B_(1), p_.sigma_floor_r)},
+      healthy_(10.0, p_.history) {
   scales_configured_ = p_.sigma_v > 0;
   const double pmin = std::min(p_.poles_v.cwiseAbs().minCoeff(), p_.poles_g.cwiseAbs().minCoeff());
   settle_time_ = p_.settle_time >= 0 ? p_.settle_time : 3.0 / pmin;
@@ -178,6 +181,10 @@ bool Isolator::design(const Mat2& A, Bank* b) {
   return true;
 }
 
+double Isolator::history_lag() const {
+  return p_.window + std::max(p_.enter_time, p_.second_fault_time) + 1.0;
+}
+
 void Isolator::publish_bank() {
   st_.A_design = act_.A;
   st_.k_v = act_.k_v;
@@ -186,6 +193,12 @@ void Isolator::publish_bank() {
   st_.sigma_d = act_.sigma_d;
   st_.thresholds = act_.threshold;
   st_.thresholds_d = act_.threshold_d;
+  if (!healthy_.empty()) {
+    for (int c = 0; c < 2; ++c) {
+      st_.thresholds(c) = std::max(st_.thresholds(c), p_.history_margin * healthy_.max(c));
+      st_.thresholds_d(c) = std::max(st_.thresholds_d(c), p_.history_margin * healthy_.max(2 + c));
+    }
+  }
   st_.threshold = act_.threshold.maxCoeff();
   st_.threshold_d = act_.threshold_d.maxCoeff();
   st_.relearning = has_shadow_;
@@ -260,6 +273,7 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
   const unsigned before = c.sources;
   c.sources = on ? (c.sources | src) : (c.sources & ~src);
   if (before == 0 && c.sources != 0) {
+    pending_stats_.clear();  // the samples before a raise are not healthy
     c.active = true;
     c.kind = kind;
     if (sensor != Sensor::kUnknown) start_monitor(sensor_index(sensor));
@@ -277,6 +291,17 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
     }
     Detection d = make_detection(sensor, false, c.kind, t);
     d.message = message;
+    out->push_back(d);
+  } else if (on && !(before & src) && (src & (kStuck | kStale | kInvalid)) &&
+             !(before & (kStuck | kStale | kInvalid)) && c.kind != kind) {
+    // A sensor-level check names the fault better than the residuals or a jump that raised
+    // it first (a frozen output is stuck, whatever moved first).
+    Detection d = make_detection(sensor, true, kind, t);
+    d.update = true;
+    d.message = std::string("kind refined from ") + to_string(c.kind) + " to " + to_string(kind) +
+                ": " + message;
+    c.kind = kind;
+    if (sensor != Sensor::kUnknown) refine_at_[sensor_index(sensor)] = kNaN;
     out->push_back(d);
   }
 }
@@ -716,6 +741,9 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       act_ = std::move(shadow_);
       shadow_ = Bank{};
       has_shadow_ = false;
+      // The healthy maxima carry over: the new design whitens its residuals with scales of
+      // its own, so its statistics are comparable, and a manoeuvre met under the old one is
+      // no less likely to come again.
       ++st_.designs;
       publish_bank();
     }
@@ -738,6 +766,16 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   }
   st_.J = act_.J;
   st_.D = act_.D;
+  if (act_.learned) {
+    // Healthy maxima, learned from samples older than a raise could be late.
+    pending_stats_.push_back(
+        PendingStat{s.t, {act_.J(0), act_.J(1), act_.D(0), act_.D(1)}, learn_ok});
+    while (!pending_stats_.empty() && s.t - pending_stats_.front().t > history_lag()) {
+      if (pending_stats_.front().ok)
+        healthy_.add(pending_stats_.front().t, pending_stats_.front().x);
+      pending_stats_.pop_front();
+    }
+  }
   st_.s = Vec2(raw[0], raw[1]);
   st_.d = Vec2(raw[2], raw[3]);
   // Monitors of raised channels: whitened like the structured residual they continue.
@@ -873,6 +911,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
                         ? reclassify == 0 ? " after an accelerometer raise" : " after a gyro raise"
                         : "");
       st_.model_mismatch = true;
+      pending_stats_.clear();
       st_.mismatch_reason = buf;
       ++st_.mismatches;
       mismatch_since_ = s.t;

@@ -23,6 +23,11 @@ constexpr int kExact = 128;           ///< sliding sums are recomputed exactly t
 /// rudder (it cannot matter): most samples skip that work.
 constexpr double kDiscountFrom = 0.25;
 
+const JumpParams& validated(const JumpParams& p) {
+  p.validate();
+  return p;
+}
+
 }  // namespace
 
 void JumpParams::validate() const {
@@ -119,13 +124,9 @@ double JumpCheck::Series::line(int m, int back) const {
 // --------------------------------------------------------------------------- JumpCheck
 
 JumpCheck::JumpCheck(const JumpParams& p, double b, double sigma_floor)
-    : p_(p), b_(b), floor_(sigma_floor) {
-  p_.validate();
+    : p_(validated(p)), b_(b), floor_(sigma_floor), healthy_(kBlock, p_.history) {
   if (!std::isfinite(b)) throw std::invalid_argument("jump check: B must be finite");
   if (!(sigma_floor > 0)) throw std::invalid_argument("jump check: the scale floor must be > 0");
-  const auto blocks = static_cast<std::size_t>(std::ceil(p_.history / kBlock));
-  blocks_T_.assign(blocks, 0.0);
-  blocks_N_.assign(blocks, 0.0);
 }
 
 void JumpCheck::resize_windows() {
@@ -281,21 +282,8 @@ void JumpCheck::learn(const Pending& s) {
   average(&sigma_, s.e2);
   average(&sigma2_, s.d2sq);
   learned_ += dt_;
-  // Healthy maxima per block of kBlock seconds, once the scales have settled.
-  if (std::isnan(block_start_)) block_start_ = s.t;
-  if (learned_ >= 0.5 * p_.learn_time) {
-    block_T_ = std::max(block_T_, s.T);
-    block_N_ = std::max(block_N_, s.N);
-  }
-  if (s.t - block_start_ >= kBlock) {
-    blocks_T_[block_next_] = block_T_;
-    blocks_N_[block_next_] = block_N_;
-    block_next_ = (block_next_ + 1) % blocks_T_.size();
-    block_T_ = block_N_ = 0.0;
-    block_start_ = s.t;
-    done_T_ = *std::max_element(blocks_T_.begin(), blocks_T_.end());
-    done_N_ = *std::max_element(blocks_N_.begin(), blocks_N_.end());
-  }
+  // The healthy maxima, once the scales have settled.
+  if (learned_ >= 0.5 * p_.learn_time) healthy_.add(s.t, {s.T, s.N});
 }
 
 JumpVerdict JumpCheck::update(double t, double y, double delta, bool learn_ok) {
@@ -400,8 +388,8 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   // Watched from half the learning on (the scales have settled), reported once armed: a
   // fault before arming is kept out of the learning, and its end is not taken for a new one.
   if (!p_.enabled || learned_ < 0.5 * p_.learn_time) return v;
-  threshold_ = std::max(p_.threshold, p_.margin * std::max(done_T_, block_T_));
-  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * std::max(done_N_, block_N_));
+  threshold_ = std::max(p_.threshold, p_.margin * healthy_.max(0));
+  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * healthy_.max(1));
 
   // Noise rise.
   if (!noise_raised_ && N_ > noise_threshold_) {

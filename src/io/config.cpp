@@ -284,6 +284,8 @@ class Loader {
          num(&is.threshold, {0, 1e3, "(whitened mean square; at most 0.75 clip^2 takes effect)"})},
         {"threshold_margin", num(&is.threshold_margin, {0, 100, ""})},
         {"threshold_k", num(&is.threshold_k, {0, 1e3, ""})},
+        {"history_margin", num(&is.history_margin, {1, 100, ""})},
+        {"history", num(&is.history, {10, 100 * kHour, "s"})},
         {"exit_ratio", num(&is.exit_ratio, {0, 1, ""})},
         {"enter_time", num(&is.enter_time, {0, 60, "s"})},
         {"leave_time", num(&is.leave_time, {0, kHour, "s"})},

@@ -81,6 +81,8 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.threshold, q.threshold);
   EXPECT_EQ(p.threshold_margin, q.threshold_margin);
   EXPECT_EQ(p.threshold_k, q.threshold_k);
+  EXPECT_EQ(p.history_margin, q.history_margin);
+  EXPECT_EQ(p.history, q.history);
   EXPECT_EQ(p.exit_ratio, q.exit_ratio);
   EXPECT_EQ(p.enter_time, q.enter_time);
   EXPECT_EQ(p.leave_time, q.leave_time);
@@ -199,6 +201,8 @@ isolation:
   stuck_time_max: 4
   spike_count: 5
   classify_window: 9
+  history_margin: 2.5
+  history: 1200
   second_fault_time: 3.5
   resume_after_fault: 4.5
 jump:
@@ -224,6 +228,8 @@ service:
   EXPECT_EQ(c.isolation.poles_g, Vec2(-3, -4));
   EXPECT_EQ(c.isolation.stuck_min_samples, 7);
   EXPECT_EQ(c.isolation.classify_window, 9.0);
+  EXPECT_EQ(c.isolation.history_margin, 2.5);
+  EXPECT_EQ(c.isolation.history, 1200.0);
   EXPECT_FALSE(c.identification.cubic_correction);
   EXPECT_EQ(c.identification.instruments, Instruments::kRegressor);
   EXPECT_EQ(c.identification.max_std_error, 0.2);

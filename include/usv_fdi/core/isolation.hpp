@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "usv_fdi/core/healthy_maxima.hpp"
 #include "usv_fdi/core/identification.hpp"
 #include "usv_fdi/core/jump_check.hpp"
 #include "usv_fdi/core/observer.hpp"
@@ -49,9 +50,15 @@ struct IsolationParams {
   double threshold = 6.0;         ///< minimum enter threshold on J_N, D_N (whitened mean square)
   double threshold_margin = 1.5;  ///< learned threshold: at least margin * 99.9 % quantile
   double threshold_k = 8.0;       ///< learned threshold: median + k robust std of healthy J_N
-  double exit_ratio = 0.5;        ///< leave threshold = exit_ratio * enter threshold
-  double enter_time = 0.06;       ///< J_N above threshold this long raises (at least 1 sample) [s]
-  double leave_time = 1.0;        ///< below the leave threshold this long clears [s]
+  /// After learning, the thresholds on J_N and D_N are at least history_margin x the largest
+  /// value each took on healthy data over the last `history` seconds: they follow the hull,
+  /// the sea and the manoeuvres met since (a J_N the model's mismatch reaches in a zigzag is
+  /// no evidence of a sensor fault) [-]
+  double history_margin = 1.5;
+  double history = 600.0;    ///< [s]
+  double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
+  double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]
+  double leave_time = 1.0;   ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
   /// in force cannot be renewed without healthy data, so its model mismatch (largest in
@@ -299,6 +306,16 @@ class Isolator {
   std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
   std::array<Channel, 3> ch_;                                    ///< v, r, delta
   std::array<JumpCheck, 2> jump_;                                ///< v, r
+  /// Healthy maxima of J_N and D_N of the bank in force [J_a, J_g, D_a, D_g], learned from
+  /// samples once they are older than a raise could be late (history_lag()).
+  HealthyMaxima<4> healthy_;
+  struct PendingStat {
+    double t;
+    double x[4];
+    bool ok;
+  };
+  std::deque<PendingStat> pending_stats_;
+  double history_lag() const;
   std::array<double, 2> jump_at_{kNaN, kNaN};  ///< time of each channel's last jump raise
   std::deque<double> timing_errors_;  ///< times of repeated / backward stamps (unknown sensor)
   std::array<Condition, 3> cond_;     ///< accelerometer, gyro, unknown

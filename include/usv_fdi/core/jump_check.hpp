@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "usv_fdi/core/healthy_maxima.hpp"
 #include "usv_fdi/core/types.hpp"
 
 namespace usvfdi {
@@ -169,10 +170,7 @@ class JumpCheck {
   double sigma_seen_ = 0.0;
   double learned_ = 0.0;  ///< healthy time seen [s]
   bool armed_ = false;
-  std::vector<double> blocks_T_, blocks_N_;  ///< maxima of completed blocks (a ring)
-  double done_T_ = 0.0, done_N_ = 0.0;       ///< the largest of them
-  std::size_t block_next_ = 0;
-  double block_start_ = kNaN, block_T_ = 0.0, block_N_ = 0.0;
+  HealthyMaxima<2> healthy_;      ///< of the step and the noise statistic
   std::vector<Pending> pending_;  ///< samples not yet learned from (a ring, oldest first)
   std::size_t pending_head_ = 0, pending_n_ = 0;
   std::vector<double> d2_;  ///< ring of the last squared second differences (noise window)

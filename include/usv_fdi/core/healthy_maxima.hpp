@@ -1,0 +1,61 @@
+// The largest values a statistic took on healthy data over a sliding history, kept as the
+// maxima of blocks of fixed length (constant memory, O(1) per sample): a threshold set at
+// a margin above them follows the hull, the sea and the manoeuvres of the recent past.
+// docs/design.md sections 8.3 and 8.6.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+namespace usvfdi {
+
+template <int N>
+class HealthyMaxima {
+ public:
+  /// block: length of a block [s]; history: how far back the maxima reach [s] (>= block).
+  HealthyMaxima(double block, double history)
+      : block_(block),
+        blocks_(static_cast<std::size_t>(std::max(1.0, std::ceil(history / block)))) {}
+
+  /// One healthy sample of the N statistics at time t.
+  void add(double t, const double (&x)[N]) {
+    if (std::isnan(start_)) start_ = t;
+    if (t - start_ >= block_) close(t);
+    for (int i = 0; i < N; ++i) current_[i] = std::max(current_[i], x[i]);
+    seen_ = true;
+  }
+  /// The largest value of statistic i over the history (0 before any sample).
+  double max(int i) const { return std::max(done_[i], current_[i]); }
+  bool empty() const { return !seen_; }
+  void clear() { *this = HealthyMaxima(block_, block_ * static_cast<double>(blocks_.size())); }
+
+ private:
+  void close(double t) {
+    blocks_[next_] = current_;
+    next_ = (next_ + 1) % blocks_.size();
+    for (int i = 0; i < N; ++i) {
+      current_[i] = 0.0;
+      done_[i] = 0.0;
+      for (const Block& b : blocks_) done_[i] = std::max(done_[i], b.v[i]);
+    }
+    start_ = t;
+  }
+  struct Block {
+    double v[N] = {};
+    Block& operator=(const double (&x)[N]) {
+      std::copy(x, x + N, v);
+      return *this;
+    }
+  };
+  double block_;
+  std::vector<Block> blocks_;
+  std::size_t next_ = 0;
+  double start_ = NAN;
+  double current_[N] = {};
+  double done_[N] = {};
+  bool seen_ = false;
+};
+
+}  // namespace usvfdi
