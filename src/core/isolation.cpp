@@ -195,8 +195,10 @@ void Isolator::publish_bank() {
   st_.thresholds_d = act_.threshold_d;
   if (!healthy_.empty()) {
     for (int c = 0; c < 2; ++c) {
-      st_.thresholds(c) = std::max(st_.thresholds(c), p_.history_margin * healthy_.max(c));
-      st_.thresholds_d(c) = std::max(st_.thresholds_d(c), p_.history_margin * healthy_.max(2 + c));
+      st_.thresholds(c) =
+          std::max(st_.thresholds(c), p_.history_margin * healthy_.extrapolated_max(c));
+      st_.thresholds_d(c) =
+          std::max(st_.thresholds_d(c), p_.history_margin * healthy_.extrapolated_max(2 + c));
     }
   }
   st_.threshold = act_.threshold.maxCoeff();
@@ -661,6 +663,9 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
         b->learn_J[c].push_back(b->J(c));
         b->learn_D[c].push_back(b->D(c));
       }
+      // The first design's learning is the healthy maxima's first data (later designs
+      // learn beside one in force, whose statistics feed them).
+      if (b == &act_) healthy_.add(s.t, {b->J(0), b->J(1), b->D(0), b->D(1)});
       b->learned_time += dt;
     }
     if (b->learned_time >= 0.5 * p_.learn_time) {

@@ -388,8 +388,8 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   // Watched from half the learning on (the scales have settled), reported once armed: a
   // fault before arming is kept out of the learning, and its end is not taken for a new one.
   if (!p_.enabled || learned_ < 0.5 * p_.learn_time) return v;
-  threshold_ = std::max(p_.threshold, p_.margin * healthy_.max(0));
-  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * healthy_.max(1));
+  threshold_ = std::max(p_.threshold, p_.margin * healthy_.extrapolated_max(0));
+  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * healthy_.extrapolated_max(1));
 
   // Noise rise.
   if (!noise_raised_ && N_ > noise_threshold_) {

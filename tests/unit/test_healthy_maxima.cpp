@@ -22,6 +22,9 @@ TEST(HealthyMaxima, AreTheLargestValuesOfTheHistoryAndForgetOlderBlocks) {
   h.add(5.0, {2.0, 7.0});
   EXPECT_EQ(h.max(0), 5.0);
   EXPECT_EQ(h.max(1), 7.0);
+  // 5 s of a 30 s history seen: the largest value so far, scaled by ln(31) / ln(6).
+  EXPECT_DOUBLE_EQ(h.covered(), 5.0);
+  EXPECT_NEAR(h.extrapolated_max(0), 5.0 * std::log(31.0) / std::log(6.0), 1e-12);
   for (double t = 10.0; t < 40.0; t += 1.0) h.add(t, {1.0, 1.0});
   // The first block (5, 7) is still one of the last three.
   EXPECT_EQ(h.max(0), 5.0);
@@ -29,6 +32,9 @@ TEST(HealthyMaxima, AreTheLargestValuesOfTheHistoryAndForgetOlderBlocks) {
   h.add(40.0, {1.0, 1.0});  // closes the fourth block: the first is forgotten
   EXPECT_EQ(h.max(0), 1.0);
   EXPECT_EQ(h.max(1), 1.0);
+  // The history is full: no extrapolation.
+  EXPECT_DOUBLE_EQ(h.covered(), 30.0);
+  EXPECT_DOUBLE_EQ(h.extrapolated_max(0), 1.0);
   h.clear();
   EXPECT_TRUE(h.empty());
 }

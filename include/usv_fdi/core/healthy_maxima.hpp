@@ -22,14 +22,30 @@ class HealthyMaxima {
   /// One healthy sample of the N statistics at time t.
   void add(double t, const double (&x)[N]) {
     if (std::isnan(start_)) start_ = t;
+    if (!std::isnan(last_) && t > last_) {
+      covered_ = std::min(covered_ + std::min(t - last_, block_), history());
+    }
+    last_ = t;
     if (t - start_ >= block_) close(t);
     for (int i = 0; i < N; ++i) current_[i] = std::max(current_[i], x[i]);
     seen_ = true;
   }
   /// The largest value of statistic i over the history (0 before any sample).
   double max(int i) const { return std::max(done_[i], current_[i]); }
+  /// ... scaled up while the history is not yet full: the largest of a few minutes of data
+  /// underestimates that of the whole history. For a statistic whose tail is exponential
+  /// (a chi-square) the largest of n independent values grows like ln n, so the maximum of
+  /// the time covered so far is scaled by ln(1 + history / tau) / ln(1 + covered / tau),
+  /// tau = 1 s (about the decorrelation time of a windowed statistic).
+  double extrapolated_max(int i) const {
+    const double full = std::log1p(history()), seen = std::log1p(std::max(covered_, 1.0));
+    return max(i) * full / seen;
+  }
+  /// Healthy time the maxima cover [s] (at most the history).
+  double covered() const { return covered_; }
+  double history() const { return block_ * static_cast<double>(blocks_.size()); }
   bool empty() const { return !seen_; }
-  void clear() { *this = HealthyMaxima(block_, block_ * static_cast<double>(blocks_.size())); }
+  void clear() { *this = HealthyMaxima(block_, history()); }
 
  private:
   void close(double t) {
@@ -52,7 +68,8 @@ class HealthyMaxima {
   double block_;
   std::vector<Block> blocks_;
   std::size_t next_ = 0;
-  double start_ = NAN;
+  double start_ = NAN, last_ = NAN;
+  double covered_ = 0.0;
   double current_[N] = {};
   double done_[N] = {};
   bool seen_ = false;
