@@ -234,6 +234,22 @@ TEST(Manoeuvre, ShipsMeetTheImoManoeuvringCriteria) {
   }
 }
 
+TEST(Manoeuvre, Kvlcc2TurnsLikeThePublishedMmgStandardModel) {
+  // Yasukawa & Yoshimura 2015 (J. Mar. Sci. Technol. 20:37-52), Table 4: the MMG standard
+  // model of the KVLCC2 L7 model (7 m) turning with 35 deg of rudder, calculated: advance
+  // 3.31 L, tactical diameter 3.36 L (their free-running tests: 3.25 L and 3.34 L). The
+  // paper's simulations moved the rudder at 1.76 deg/s full scale, this hull at the SIMMAN
+  // test rate of 2.32 deg/s (docs/vessels.md), which turns a little tighter; 10 %, about
+  // twice the paper's own calculation-to-experiment differences, is allowed.
+  const Hull& h = hull("kvlcc2");
+  const double L = h.limits().length;
+  const TurningCircle tc = turning_circle(h, h.nominal_speed(), 35 * kDeg);
+  std::printf("kvlcc2 35 deg turn: advance %.2f L, tactical diameter %.2f L\n", tc.advance / L,
+              tc.tactical_diameter / L);
+  EXPECT_NEAR(tc.advance / L, 3.31, 0.10 * 3.31);
+  EXPECT_NEAR(tc.tactical_diameter / L, 3.36, 0.10 * 3.36);
+}
+
 TEST(Manoeuvre, NonlinearHullsLoseSpeedInATurn) {
   for (const ZooEntry& e : zoo()) {
     if (!e.hull->nonlinear()) continue;
