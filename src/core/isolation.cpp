@@ -548,13 +548,16 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
     // Once the observers are live they hold a jump like any residual fault (their cross
     // residual sees whether the offset is still there, or has gone without a jump back).
     if ((cond_[c].sources & kJump) && model_live()) {
+      const bool held = cond_[c].sources & kResidual;  // the observers hold it already
       set_condition(sensor, kResidual, true, FaultKind::kBias, s.t,
                     std::string(name) + "held by the observers", out);
       set_condition(sensor, kJump, false, FaultKind::kBias, s.t, "", out);
-      raised_at_[c] = s.t;
-      below_since_[c] = kNaN;
-      // Its kind is refined from the residuals' shape like any other (a scale error jumps too).
-      if (cond_[c].kind == FaultKind::kBias) refine_at_[c] = s.t + 0.5 * p_.classify_window;
+      if (!held) {
+        raised_at_[c] = s.t;
+        below_since_[c] = kNaN;
+        // Its kind is refined from the residuals' shape like any other (a scale error jumps).
+        if (cond_[c].kind == FaultKind::kBias) refine_at_[c] = s.t + 0.5 * p_.classify_window;
+      }
       jump_[c].release();
     }
     if (v.noise != JumpVerdict::Change::kNone) {
@@ -663,9 +666,6 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
         b->learn_J[c].push_back(b->J(c));
         b->learn_D[c].push_back(b->D(c));
       }
-      // The first design's learning is the healthy maxima's first data (later designs
-      // learn beside one in force, whose statistics feed them).
-      if (b == &act_) healthy_.add(s.t, {b->J(0), b->J(1), b->D(0), b->D(1)});
       b->learned_time += dt;
     }
     if (b->learned_time >= 0.5 * p_.learn_time) {

@@ -18,9 +18,11 @@ namespace usvfdi::io {
 namespace {
 
 /// 120 s of the paper scenario on the Otter at 10 Hz, each sample passed through `change`.
-std::vector<Sample> voyage(const std::function<void(Sample*)>& change = {}) {
+std::vector<Sample> voyage(const std::function<void(Sample*)>& change = {},
+                           bool with_faults = true) {
   SimConfig c = paper_scenario(otter(), 10.0, 3);
   c.duration = 120.0;
+  if (!with_faults) c.faults.clear();
   std::vector<Sample> out;
   for (const SimRow& row : simulate(c)) {
     Sample s{row.t, row.v, row.r, row.delta};
@@ -100,7 +102,9 @@ TEST(Plausibility, ConvergenceReportSaysWhy) {
     for (const Sample& s : samples) engine.process(s, &events);
     return engine.estimate();
   };
-  const Estimate good = run(voyage());
+  // (the paper's faults left out: the jump check raises them, and identification rightly
+  // does not learn from the 20 + 20 s they last and the 10 s after each)
+  const Estimate good = run(voyage({}, false));
   ASSERT_TRUE(good.converged);
   EXPECT_EQ(convergence_report(good, cfg.identification), "");
 

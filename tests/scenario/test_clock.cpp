@@ -15,7 +15,8 @@ namespace {
 const std::string kSource = USV_FDI_SOURCE_DIR;
 
 /// A 10 Hz Otter voyage; with_faults: an accelerometer bias on [150, 160) s and a gyro
-/// drift on [165, 175) s (as the golden case faults_otter).
+/// drift on [165, 175) s (the golden case faults_otter has the same two, with a drift of
+/// 6.7 sigma in 10 s that the engine no longer raises; see below).
 std::vector<SimRow> voyage(double duration, std::uint64_t seed, bool with_faults) {
   SimConfig sim;
   EXPECT_TRUE(find_vessel("otter", &sim.vessel));
@@ -24,7 +25,10 @@ std::vector<SimRow> voyage(double duration, std::uint64_t seed, bool with_faults
   sim.seed = seed;
   if (with_faults) {
     sim.faults.push_back({Sensor::kAccelerometer, FaultKind::kBias, 150.0, 160.0, 0.05});
-    sim.faults.push_back({Sensor::kGyro, FaultKind::kDrift, 165.0, 175.0, 0.000333});
+    // 10 sigma in 10 s (a slower one is left to the end of the ramp: since the observers
+    // confirm a raise for isolation.enter_time, 2 s, a drift of 6.7 sigma in 10 s is no
+    // longer raised here)
+    sim.faults.push_back({Sensor::kGyro, FaultKind::kDrift, 165.0, 175.0, 0.0005});
   }
   return simulate(sim);
 }

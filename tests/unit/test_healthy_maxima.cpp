@@ -79,6 +79,7 @@ TEST(IsolatorThresholds, AModelMismatchMetInHealthyManoeuvresRaisesTheBar) {
   // GIVEN the same course changes again and again, with a model that is off in each
   IsolationParams p;
   p.jump.enabled = false;  // the observers alone
+  p.enter_time = 0.06;     // and no confirmation time: the thresholds alone
   // WHEN the thresholds remember the healthy past (10 minutes) THEN after the first ten
   // minutes nothing is raised
   EXPECT_EQ(raises_after(p, 600.0), 0);

@@ -175,11 +175,11 @@ TEST(JumpCheck, DroppedSamplesAreFilledAndALongGapRestartsTheWindows) {
 }
 
 TEST(JumpCheck, NothingIsRaisedBeforeLearnTimeAndAnUnreturnedJumpIsHeldForHoldMax) {
-  // GIVEN an offset on [40, 50) s, before the check has learned for learn_time, and one
-  // from 100 s on
+  // GIVEN an offset on [11, 13) s, before the check has learned for learn_time (it watches
+  // from half of it), and one from 100 s on
   Channel c;
   const auto rows = channel(c, 200.0, [](double t, long) {
-    return (t >= 40.0 && t < 50.0) || t >= 100.0 ? 10.0 * kSigma : 0.0;
+    return (t >= 11.0 && t < 13.0) || t >= 100.0 ? 10.0 * kSigma : 0.0;
   });
   JumpParams p;
   const Seen s = run_check(rows, p);

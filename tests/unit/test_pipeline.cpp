@@ -161,6 +161,7 @@ TEST(FdiPipeline, PaperScenarioThroughTheThreadsRaisesBothFaults) {
   cfg.isolation.sigma_r = 0.0005;
   cfg.isolation.settle_time = 2.0;
   cfg.isolation.learn_time = 3.0;
+  cfg.isolation.enter_time = 0.06;  // as config/scenarios/paper.yaml: the exact model, no mismatch
   Collected c;
   PipelineOptions opt;
   opt.input_capacity = 1 << 16;  // the test pushes faster than real time: no drops
@@ -230,6 +231,7 @@ TEST(FdiPipeline, TheDetectorSupervisesIdentificationAsInTheReplay) {
   cfg.isolation.sigma_r = 0.0005;
   cfg.isolation.settle_time = 2.0;
   cfg.isolation.learn_time = 3.0;
+  cfg.isolation.enter_time = 0.06;  // as config/scenarios/paper.yaml: the exact model, no mismatch
   const std::vector<SimRow> rows = simulate(sim);
   FdiEngine engine(cfg);
   std::vector<FaultEvent> evs;
@@ -269,6 +271,7 @@ EngineConfig paper_config(const VesselModel& v) {
   cfg.isolation.sigma_r = 0.0005;
   cfg.isolation.settle_time = 2.0;
   cfg.isolation.learn_time = 3.0;
+  cfg.isolation.enter_time = 0.06;  // as config/scenarios/paper.yaml: the exact model, no mismatch
   return cfg;
 }
 

@@ -55,10 +55,13 @@ struct IsolationParams {
   /// the sea and the manoeuvres met since (a J_N the model's mismatch reaches in a zigzag is
   /// no evidence of a sensor fault) [-]
   double history_margin = 1.5;
-  double history = 600.0;    ///< [s]
-  double exit_ratio = 0.5;   ///< leave threshold = exit_ratio * enter threshold
-  double enter_time = 0.06;  ///< J_N above threshold this long raises (at least 1 sample) [s]
-  double leave_time = 1.0;   ///< below the leave threshold this long clears [s]
+  double history = 600.0;   ///< [s]
+  double exit_ratio = 0.5;  ///< leave threshold = exit_ratio * enter threshold
+  /// J_N above threshold this long raises (at least 1 sample), the other channel staying
+  /// quiet: model mismatch lights the other channel within seconds, a single sensor's fault
+  /// never (and the jump check raises a sudden offset at once) [s]
+  double enter_time = 2.0;
+  double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
   /// in force cannot be renewed without healthy data, so its model mismatch (largest in

@@ -50,7 +50,7 @@ struct JumpParams {
   double noise_threshold = 4.0;  ///< floor of the noise statistic's threshold [-]
   double margin = 2.0;           ///< thresholds >= margin x the healthy maximum [-]
   double noise_window = 1.0;     ///< mean square of the innovations over this [s]
-  double learn_time = 60.0;      ///< healthy data before the check is armed [s]
+  double learn_time = 15.0;      ///< healthy data before the check reports (watched from half) [s]
   double history = 600.0;        ///< the healthy maximum is that of this long [s]
   double scale_time = 30.0;      ///< averaging time of the innovation scale [s]
   double leave_time = 1.0;       ///< a noise rise clears after this long below [s]
