@@ -566,6 +566,12 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
                     s.t, name + v.message, out);
       patch(before, kNaN, st_.noise_N(c), st_.noise_threshold(c));
     }
+    // A jump the check no longer holds (withdrawn as the first samples of a noise rise) is
+    // no source of this condition either.
+    if ((cond_[c].sources & kJump) && !jump_[c].jump_raised()) {
+      set_condition(sensor, kJump, false, FaultKind::kBias, s.t,
+                    std::string(name) + "jump withdrawn", out);
+    }
   }
 }
 

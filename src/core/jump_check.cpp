@@ -83,7 +83,7 @@ void JumpCheck::Series::push(double x) {
     S1_ += count_ * x;
     S0_ += x;
   }
-  ++count_;
+  if (count_ < (1 << 30)) ++count_;  // only compared with the windows' lengths
   if (count_ < L_) return;
   if (++since_exact_ >= kExact) {  // bound the round-off of the sliding sums
     since_exact_ = 0;
@@ -165,7 +165,7 @@ void JumpCheck::push(double t, double z, double I, double delta) {
   z_.push(z);
   i_.push(I);
   d_.push(delta);
-  ts_[static_cast<std::size_t>((z_.count() - 1) % static_cast<int>(ts_.size()))] = t;
+  ts_[static_cast<std::size_t>(z_.newest())] = t;
 }
 
 void JumpCheck::keep_newest(int keep) {
@@ -173,7 +173,7 @@ void JumpCheck::keep_newest(int keep) {
   const int cap = static_cast<int>(ts_.size());
   for (int k = 0; k < keep; ++k) {
     const int back = keep - 1 - k;
-    t[k] = ts_[static_cast<std::size_t>((z_.count() - 1 - back) % cap)];
+    t[k] = ts_[static_cast<std::size_t>((z_.newest() - back + cap) % cap)];
     z[k] = z_.at(back);
     I[k] = i_.at(back);
     d[k] = d_.at(back);
@@ -311,13 +311,16 @@ JumpVerdict JumpCheck::update(double t, double y, double delta, bool learn_ok) {
 
 JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   JumpVerdict v;
-  if (std::isfinite(delta)) {
-    if (std::isfinite(last_t_) && std::isfinite(last_delta_)) {
-      I_ += 0.5 * (last_delta_ + delta) * (t - last_t_);
-    }
-    last_delta_ = delta;
+  if (!std::isfinite(t)) return v;
+  // The rudder integral over every interval, once (the angle held over a missing one),
+  // whether or not this sample's y is usable.
+  const double d_now = std::isfinite(delta) ? delta : last_delta_;
+  if (std::isfinite(int_t_) && std::isfinite(last_delta_) && std::isfinite(d_now)) {
+    I_ += 0.5 * (last_delta_ + d_now) * (t - int_t_);
   }
-  if (!std::isfinite(y) || !std::isfinite(t)) return v;
+  int_t_ = t;
+  last_delta_ = d_now;
+  if (!std::isfinite(y)) return v;
   if (raised_ && t - raised_at_ >= p_.hold_max) {
     raised_ = false;
     v.step = JumpVerdict::Change::kClear;
@@ -394,6 +397,7 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   // Noise rise.
   if (!noise_raised_ && N_ > noise_threshold_) {
     noise_raised_ = true;
+    noise_raised_at_ = t;
     noise_below_since_ = kNaN;
     v.noise = JumpVerdict::Change::kRaise;
     pending_n_ = 0;
@@ -407,7 +411,11 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
     }
     return v;
   }
+  if (noise_raised_ && !noise_reported_ && !armed_ && t - noise_raised_at_ >= p_.hold_max) {
+    noise_raised_ = false;  // a rise watched before arming must not stop the learning forever
+  }
   if (noise_raised_) {
+    if (d2_n_ < d2_.size()) return v;  // refilling after a restart: no verdict
     if (N_ < p_.exit_ratio * noise_threshold_) {
       if (std::isnan(noise_below_since_)) noise_below_since_ = t;
       if (t - noise_below_since_ >= p_.leave_time) {
@@ -423,7 +431,7 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   // Step.
   if (m_best < 0 || !(T_ > threshold_) || !persists(m_best, f_best)) return v;
   const int cap = static_cast<int>(ts_.size());
-  const double onset = ts_[static_cast<std::size_t>((z_.count() - 1 - m_best) % cap)];
+  const double onset = ts_[static_cast<std::size_t>((z_.newest() - m_best + cap) % cap)];
   pending_n_ = 0;
   char buf[200];
   if (!raised_) {

@@ -174,6 +174,31 @@ TEST(JumpCheck, DroppedSamplesAreFilledAndALongGapRestartsTheWindows) {
   EXPECT_TRUE(s.noises.empty());
 }
 
+TEST(JumpCheck, AMissingValueOrRudderAngleMakesNoJumpOfTheRuddersPart) {
+  // GIVEN a hull whose rudder turns it fast (b = -2.2, the Otter's yaw), the rudder at
+  // 0.2 rad, and now and then a missing channel value or a missing rudder angle: the rudder
+  // integral must count every interval once, whatever is missing on a sample
+  const double b = -2.2, sigma = 5e-4;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  JumpCheck check(JumpParams{}, b, 1e-5);
+  int verdicts = 0;
+  double I = 0.0;
+  for (int k = 0; k <= 3000; ++k) {
+    const double t = 0.1 * k;
+    const double delta = 0.2 + 0.05 * std::sin(0.1 * t);
+    if (k > 0) I += 0.1 * 0.5 * (delta + 0.2 + 0.05 * std::sin(0.1 * (t - 0.1)));
+    double y = b * I + sigma * n01(rng);
+    double d = delta;
+    if (k > 200 && k % 97 == 0) y = kNaN;
+    if (k > 200 && k % 89 == 0) d = kNaN;
+    const JumpVerdict v = check.update(t, y, d, true);
+    verdicts += v.step != JumpVerdict::Change::kNone || v.noise != JumpVerdict::Change::kNone;
+  }
+  EXPECT_TRUE(check.armed());
+  EXPECT_EQ(verdicts, 0);
+}
+
 TEST(JumpCheck, NothingIsRaisedBeforeLearnTimeAndAnUnreturnedJumpIsHeldForHoldMax) {
   // GIVEN an offset on [11, 13) s, before the check has learned for learn_time (it watches
   // from half of it), and one from 100 s on

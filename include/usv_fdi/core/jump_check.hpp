@@ -111,7 +111,8 @@ class JumpCheck {
     void reset(int L, int M);
     void clear();
     void push(double x);
-    int count() const { return count_; }  ///< samples since clear()
+    int count() const { return count_; }    ///< samples since clear() (capped at 2^30)
+    int newest() const { return newest_; }  ///< the newest sample's place in the ring
     /// The value `back` samples before the newest (0: the newest).
     double at(int back) const {
       const int k = newest_ - back;  // back < cap_
@@ -163,7 +164,8 @@ class JumpCheck {
   int dt_seen_ = 0;
   std::vector<double> first_t_;  ///< the first samples' times (for dt)
   double last_t_ = kNaN, last_z_ = kNaN, last_I_ = kNaN, last_d_ = kNaN;
-  double I_ = 0.0;  ///< int delta dt since the restart [rad s]
+  double I_ = 0.0;       ///< int delta dt since the restart [rad s]
+  double int_t_ = kNaN;  ///< the time the integral has reached [s]
   double last_delta_ = kNaN;
   // Learning.
   double sigma_ = 0.0, sigma2_ = 0.0;  ///< scales of the innovation and the 2nd difference
@@ -185,6 +187,7 @@ class JumpCheck {
   double offset_ = 0.0;  ///< the offset since the raise (the jumps added up)
   double raised_at_ = kNaN;
   bool noise_raised_ = false;
+  double noise_raised_at_ = kNaN;
   double noise_below_since_ = kNaN;
 };
 
