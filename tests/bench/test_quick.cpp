@@ -103,7 +103,12 @@ TEST(BenchQuick, HarnessWorksAndTheOracleDetectsTheFaults) {
     } else {
       EXPECT_EQ(o.armed_runs, o.runs);
     }
-    EXPECT_LT(o.arming_max, 120.0);
+    // Learning pauses while a suspicion is held (healthy thresholds are learned from healthy
+    // data only): on the open-loop unstable otter3dof at 50 Hz the jump check suspects some of
+    // the autopilot's fast rudder reversals in the first minute, and learning ends after up to
+    // 137 s instead of 67 s. Three minutes bounds that with room; a learning that never ends
+    // would fail it.
+    EXPECT_LT(o.arming_max, 180.0);
   }
 
   // The oracle, given the true (linearised) A, detects the injected faults: every bias,
