@@ -67,47 +67,16 @@ const char* to_string(IdentStatus s) {
   return "?";
 }
 
-void Identifier::Memory::step(double E, double dt, const Vec2& q, const Vec2& m, const Vec2& z) {
-  const double E2 = E * E;
-  Pqq = E * Pqq + dt * (q * q.transpose());
-  Yqm = E * Yqm + dt * (q * m.transpose());
-  Pzq = E * Pzq + dt * (z * q.transpose());
-  Yzm = E * Yzm + dt * (z * m.transpose());
-  Zm = E2 * Zm + dt * (z * z.transpose());
-  Szz = E * Szz + dt * z.cwiseProduct(z);
-  W2 = E2 * W2 + dt;
-  decay *= E;
-  len += dt;
-}
-
-void Identifier::Memory::remove(const Memory& seg, double E) {
-  const double E2 = E * E;
-  Pqq -= E * seg.Pqq;
-  Yqm -= E * seg.Yqm;
-  Pzq -= E * seg.Pzq;
-  Yzm -= E * seg.Yzm;
-  Zm -= E2 * seg.Zm;
-  Szz -= E * seg.Szz;
-  W2 -= E2 * seg.W2;
-}
-
-void Identifier::Memory::append(const Memory& seg) {
-  const double E = seg.decay, E2 = E * E;
-  Pqq = E * Pqq + seg.Pqq;
-  Yqm = E * Yqm + seg.Yqm;
-  Pzq = E * Pzq + seg.Pzq;
-  Yzm = E * Yzm + seg.Yzm;
-  Zm = E2 * Zm + seg.Zm;
-  Szz = E * Szz + seg.Szz;
-  W2 = E2 * W2 + seg.W2;
-}
-
 Identifier::Identifier(const IdentificationParams& params, const Vec2& B, const SpeedParams& speed)
     : p_(params),
       B_(B),
       f1_(params.eps1),
       f2_(params.eps2),
       speed_(speed),
+      guard_(ConsistencyGuard::Settings{
+          params.guard && params.method == IdentMethod::kKreisselmeier, params.lambda, params.eps1,
+          params.guard_threshold, params.guard_min_shift, params.guard_recent_time,
+          params.settle_floor}),
       a_(params.a0),
       a_ref_(params.a0) {
   p_.validate();
@@ -116,7 +85,6 @@ Identifier::Identifier(const IdentificationParams& params, const Vec2& B, const 
   warmup_ = p_.warmup_time >= 0 ? p_.warmup_time : 10.0 / eps_min;
   est_.A = from_params(a_);
   est_.time_constant = std::numeric_limits<double>::infinity();
-  stored_.resize(kStored);
   // Before any estimate: poles -eps1 +- i eps1, so x_aux has two independent components for
   // any B != 0 (B is never an eigenvector of a rotation).
   A_aux_ << -p_.eps1, p_.eps1, -p_.eps1, -p_.eps1;
@@ -155,16 +123,11 @@ void Identifier::refresh_aux_model(double t) {
   // waiting for their verdict: the instruments need no verdict (any A_aux gives valid
   // ones), only to resemble q as early as possible, and a rejected segment leaves this sum
   // with the next refresh.
-  Mat2 Pqq = mem_.Pqq, Yqm = mem_.Yqm;
-  for (const Pending& f : pending_) {
-    Pqq = f.mem.decay * Pqq + f.mem.Pqq;
-    Yqm = f.mem.decay * Yqm + f.mem.Yqm;
-  }
-  Pqq = seg_.decay * Pqq + seg_.Pqq;
-  Yqm = seg_.decay * Yqm + seg_.Yqm;
-  const double det = Pqq.determinant();
-  if (!(det > 1e-6 * Pqq(0, 0) * Pqq(1, 1))) return;
-  Mat2 A = (Pqq.partialPivLu().solve(Yqm)).transpose();
+  Mat2 Phi_ls, Y_ls;
+  guard_.least_squares_with_pending(&Phi_ls, &Y_ls);
+  const double det = Phi_ls.determinant();
+  if (!(det > 1e-6 * Phi_ls(0, 0) * Phi_ls(1, 1))) return;
+  Mat2 A = (Phi_ls.partialPivLu().solve(Y_ls)).transpose();
   if (!A.allFinite()) return;
   // Slowest pole no slower than -lambda: shift the spectrum left where needed.
   const double half_tr = 0.5 * A.trace(), disc = half_tr * half_tr - A.determinant();
@@ -190,12 +153,7 @@ void Identifier::restart_filters(const Sample& s) {
   z_.setZero();  // x_aux_ carries on: it depends on the rudder only
   // A window must not straddle the restart (the sums after it use fresh filters), and the
   // data no window has judged yet is dropped with them.
-  open_[0] = Batch{};
-  open_[0].active = true;
-  open_[1] = Batch{};  // begins with the second segment, half a window later
-  seg_ = Memory{};
-  pending_.clear();
-  first_segment_ = true;
+  guard_.restart();
   prev_ = s;
   have_prev_ = true;
   have_prev2_ = false;
@@ -308,378 +266,78 @@ bool Identifier::update(const Sample& s, bool freeze) {
 }
 
 void Identifier::step_memories(double t, double dt, bool rudder_iv) {
-  const double E = std::exp(-p_.lambda * dt);
-  seg_.step(E, dt, qs_, m_, z_);
-  // Tapered window sums of z q^T, z m^T, z z^T (two Hann windows, half a window apart).
-  const double T_b = kBatchLength / p_.eps1;
-  for (Batch& b : open_) {
-    if (!b.active) continue;
-    b.T += dt;
-    const double sn = std::sin(M_PI * std::min(1.0, b.T / T_b));
-    const double w = sn * sn;  // Hann window
-    b.P += w * dt * (z_ * qs_.transpose());
-    b.G += w * dt * (z_ * m_.transpose());
-    b.Z += w * w * dt * (z_ * z_.transpose());
-    b.H2 += w * w * dt;
+  const ConsistencyGuard::Change c = guard_.add(t, dt, qs_, m_, z_, est_.converged, supervised_);
+  const GuardReport& g = guard_.report();
+  est_.consistent = g.consistent;
+  est_.consistency = g.consistency;
+  est_.inconsistent_time = g.inconsistent_time;
+  est_.rejected_windows = g.rejected_windows;
+  est_.rejected_time = g.rejected_time;
+  est_.removed_windows = g.removed_windows;
+  est_.resets = g.resets;
+  est_.memory_mismatch = g.memory_mismatch;
+  if (c.unsettled) settled_count_ = 0;
+  if (c.reset) {
+    t_ref_ = kNaN;
+    est_.std_error = Vec4::Constant(kNaN);
   }
-  if (seg_.len >= 0.5 * T_b * (1.0 - 1e-9)) close_segment(t, rudder_iv);
-}
-
-void Identifier::close_segment(double t, bool rudder_iv) {
-  Pending seg;
-  seg.mem = seg_;
-  seg.id = next_seg_++;
-  seg.needed = first_segment_ ? 1 : 2;
-  pending_.push_back(seg);
-  seg_ = Memory{};
-  first_segment_ = false;
-  // The window that now spans two segments is complete: its verdict is that of both.
-  for (Batch& b : open_) {
-    if (!b.active || ++b.segs < 2) continue;
-    b.seg1 = pending_.back().id;
-    b.seg0 = b.seg1 - 1;  // segment ids are consecutive since the restart it began after
-    b.accepted = judge(b);
-    b.clock = clock_;
-    b.t_end = t;
-    windows_.push_back(b);
-    if (static_cast<int>(windows_.size()) > kWindows) windows_.pop_front();
-    const std::size_t n = pending_.size();
-    for (std::size_t k = n >= 2 ? n - 2 : 0; k < n; ++k) {
-      ++pending_[k].votes;
-      pending_[k].bad = pending_[k].bad || !b.accepted;
-    }
-    b = Batch{};
-    b.active = true;
-  }
-  for (Batch& b : open_) {
-    if (!b.active) {  // the second window begins with the second segment
-      b = Batch{};
-      b.active = true;
-    }
-  }
-  // Commit the segments every covering window has judged, in order (every closed segment
-  // is kept, rejected or not: recent data may replace the memory, see check_memory).
-  bool changed = false;
-  while (!pending_.empty() && pending_.front().votes >= pending_.front().needed) {
-    const Pending& f = pending_.front();
-    Stored& st = stored_[f.id % kStored];
-    st.mem = f.mem;
-    st.id = f.id;
-    st.in = !f.bad;
-    if (f.bad) {
-      inconsistent_run_ += f.mem.len;
-      est_.rejected_time += f.mem.len;
-      // A window that shares data with a rejected one is no clean sample of the noise.
-      for (Batch& w : windows_) {
-        if (w.seg0 == f.id || w.seg1 == f.id) w.accepted = false;
-      }
-    } else {
-      mem_.append(f.mem);
-      clock_ += f.mem.len;
-      st.clock = clock_;
-      inconsistent_run_ = 0.0;
-      changed = true;
-    }
-    pending_.pop_front();
-  }
-  // With more data the memory may show that something it took in earlier disagrees with
-  // the rest (a fault before the guard could judge): take it out again. Or the recent data,
-  // consistent among themselves, show that the memory as a whole is wrong.
-  if (changed) rejudge();
-  if (check_memory(t)) changed = true;
-  est_.inconsistent_time = inconsistent_run_;
-  if (est_.converged && supervised_ && inconsistent_run_ >= p_.guard_recent_time) {
-    // After convergence a lasting change of the data that the isolation thread does not
-    // take for a sensor fault is a change of the vessel: forgetting follows it.
-    guard_suspended_ = true;
-    inconsistent_run_ = 0.0;
-  }
-  if (changed) {
+  if (c.memory) {
     commit_mixing(rudder_iv);
     update_std_error();
   }
 }
 
-bool Identifier::check_memory(double t) {
-  // Before convergence: the memory's estimate A_L against the estimate A_s of the windows of
-  // the last guard_recent_time alone (accepted or not). When the recent data agree among
-  // themselves (no window beyond the threshold under A_s, with the noise level of their
-  // own fit) and A_s differs from A_L by more than both estimates' uncertainties allow (a
-  // Wald test, chi-square with 4 degrees of freedom when both describe the same vessel),
-  // the memory is what is wrong: a fault in it from the start, or from before the guard
-  // could judge, that the healthy data since cannot outweigh (the memory may even reject
-  // them). It is rebuilt from the recent segments. Recent data that disagree among
-  // themselves (a fault still in the recent span) change nothing.
-  if (!p_.guard || est_.converged || windows_.empty()) return false;
-  Mat2 AtL;
-  if (!memory_estimate(&AtL)) return false;
-  const auto final_segment = [this](std::uint64_t id) {
-    return stored_[id % kStored].id == id;  // stored once every covering window judged it
-  };
-  const double T_b = kBatchLength / p_.eps1;
-  std::vector<const Batch*> S;
-  for (const Batch& b : windows_) {
-    if (b.t_end < t - p_.guard_recent_time + 0.5 * T_b) continue;
-    if (!final_segment(b.seg0) || !final_segment(b.seg1)) continue;
-    if (!S.empty() && b.seg0 > S.back()->seg1) return false;  // a gap (restart) in the span
-    S.push_back(&b);
-  }
-  const int needed = static_cast<int>(2.0 * p_.guard_recent_time / T_b) - 2;
-  if (static_cast<int>(S.size()) < std::max(needed, kMinJudge)) return false;
-  Mat2 P = Mat2::Zero(), G = Mat2::Zero(), Z = Mat2::Zero();
-  for (const Batch* b : S) {
-    P += b->P;
-    G += b->G;
-    Z += b->Z;
-  }
-  if (!(std::abs(P.determinant()) > 0)) return false;
-  const Mat2 Ps = P.inverse();
-  const Mat2 AtS = Ps * G;
-  if (!AtS.allFinite()) return false;
-  // The recent data's own noise level (robust: the median window) and their worst window.
-  std::vector<double> q[2];
-  std::vector<Mat2> Zi(S.size());
-  for (std::size_t k = 0; k < S.size(); ++k) {
-    if (!(S[k]->Z.determinant() > 0)) return false;
-    Zi[k] = S[k]->Z.inverse();
-    const Mat2 r = S[k]->G - S[k]->P * AtS;
-    for (int i = 0; i < 2; ++i) q[i].push_back(r.col(i).dot(Zi[k] * r.col(i)));
-  }
-  Vec2 s2;
-  for (int i = 0; i < 2; ++i) {
-    std::vector<double> v = q[i];
-    auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    s2(i) = *mid / (2.0 * M_LN2);
-  }
-  if (!(s2.minCoeff() > 0)) return false;
-  for (std::size_t k = 0; k < S.size(); ++k) {
-    if (!(q[0][k] / s2(0) + q[1][k] / s2(1) <= p_.guard_threshold)) return false;
-  }
-  // Wald test of A_s = A_L: Cov(row i) = s_i (Ps Z Ps^T + Pzq^-1 Zm Pzq^-T).
-  const Mat2 PL = mem_.Pzq.inverse();
-  const Mat2 C = Ps * Z * Ps.transpose() + PL * mem_.Zm * PL.transpose();
-  if (!(C.determinant() > 0)) return false;
-  const Mat2 Ci = C.inverse();
-  const Mat2 d = AtS - AtL;
-  double W = 0.0;
-  for (int i = 0; i < 2; ++i) W += d.col(i).dot(Ci * d.col(i)) / s2(i);
-  est_.memory_mismatch = W;
-  if (!(W > p_.guard_threshold)) return false;
-  // Rebuild the memory from the recent segments, oldest first.
-  mem_ = Memory{};
-  for (Stored& st : stored_) st.in = false;
-  for (std::uint64_t id = S.front()->seg0; id <= S.back()->seg1; ++id) {
-    Stored& st = stored_[id % kStored];
-    if (st.id != id) continue;
-    mem_.append(st.mem);
-    clock_ += st.mem.len;
-    st.clock = clock_;
-    st.in = true;
-  }
-  const std::uint64_t first = S.front()->seg0;
-  for (Batch& b : windows_) {
-    b.accepted = b.seg0 >= first && final_segment(b.seg0) && final_segment(b.seg1);
-    b.clock = clock_;
-  }
-  inconsistent_run_ = 0.0;
-  settled_count_ = 0;
-  t_ref_ = kNaN;
-  est_.std_error = Vec4::Constant(kNaN);
-  ++est_.resets;
-  return true;
-}
-
-int Identifier::accepted_windows() const {
-  int n = 0;
-  for (const Batch& b : windows_) n += b.accepted;
-  return n;
-}
-
-bool Identifier::memory_estimate(Mat2* At) const {
-  const Mat2& P = mem_.Pzq;
-  const double det = P.determinant();
-  if (!std::isfinite(det) || !(std::abs(det) > 0)) return false;
-  *At = P.inverse() * mem_.Yzm;
-  return At->allFinite();
-}
-
-void Identifier::update_noise(const Mat2& At) {
-  // The long-run variance density s_i of the equation error e_i = m_i - a_i q, from the
-  // accepted windows: r = G_i - P a_i has covariance s_i int h^2 z z^T, so r^T Z^-1 r / s_i
-  // is chi-square with 2 degrees of freedom. The median (2 ln 2 of them) is robust to the
-  // few windows a fault may have brought in; normalising by each window's own Z makes it
-  // independent of the instruments' scale (a refreshed auxiliary model changes nothing).
-  noise_.setZero();
-  std::vector<double> q[2];
-  for (const Batch& b : windows_) {
-    if (!b.accepted || !(b.Z.determinant() > 0)) continue;
-    const Mat2 Zi = b.Z.inverse();
-    const Mat2 r = b.G - b.P * At;
-    for (int i = 0; i < 2; ++i) q[i].push_back(r.col(i).dot(Zi * r.col(i)));
-  }
-  if (static_cast<int>(q[0].size()) < kMinBatches) return;
-  for (int i = 0; i < 2; ++i) {
-    auto mid = q[i].begin() + static_cast<std::ptrdiff_t>(q[i].size() / 2);
-    std::nth_element(q[i].begin(), mid, q[i].end());
-    noise_(i) = *mid / (2.0 * M_LN2);
-  }
-}
-
-bool Identifier::judge(const Batch& b) {
-  // The window's equation-error sums r_i = int h z e_i = G_i - P a^_i (a^_i: row i of the
-  // memory's estimate) against what healthy data give: Var(r_i) = s_i (int h^2 z z^T + P
-  // Pzq^-1 Zm Pzq^-T P^T), the window's noise plus the memory's uncertainty in a^_i, so
-  // T = sum_i r_i^T Var(r_i)^-1 r_i is chi-square with 4 degrees of freedom on healthy
-  // data. A sensor fault (bias, drift, scale, a noise burst, spikes) breaks m = A q by far
-  // more: the window, and the data it covers, stay out of the memory.
-  est_.consistent = true;
-  est_.consistency = 0.0;
-  Mat2 At;
-  if (!p_.guard || accepted_windows() < kMinJudge || !memory_estimate(&At)) return true;
-  update_noise(At);
-  if (!(noise_.minCoeff() > 0)) return true;
-  const Mat2 Pinv = mem_.Pzq.inverse();
-  const Mat2 S = b.Z + b.P * (Pinv * mem_.Zm * Pinv.transpose()) * b.P.transpose();
-  if (!(S.determinant() > 0)) return true;
-  const Mat2 Si = S.inverse();
-  const Mat2 r = b.G - b.P * At;
-  double T = 0.0;
-  for (int i = 0; i < 2; ++i) T += r.col(i).dot(Si * r.col(i)) / noise_(i);
-  // Materiality: how far the window would move A^ (rounding-level inconsistencies of exact
-  // data move nothing).
-  const Mat2 D = (mem_.Pzq + b.P).inverse() * r;
-  double shift = 0.0;
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      shift = std::max(shift, std::abs(D(j, i)) / std::max(std::abs(At(j, i)), p_.settle_floor));
-    }
-  }
-  const bool ok = !(T > p_.guard_threshold && shift > p_.guard_min_shift);
-  est_.consistent = ok;
-  est_.consistency = T;
-  if (!ok) {
-    ++est_.rejected_windows;
-    settled_count_ = 0;
-  }
-  if (guard_suspended_) {
-    if (ok) guard_suspended_ = false;  // the data agree with the memory again
-    return true;
-  }
-  return ok;
-}
-
-bool Identifier::rejudge() {
-  // Every accepted window whose data are still in the memory, against the memory itself
-  // (in-sample, so Var(r_i) <= s_i Z: the test is conservative). The worst one beyond the
-  // threshold leaves, and the memory is judged again without it, as long as one does: a
-  // fault that came in before the guard could judge (the first kMinJudge windows, or right
-  // after a reset) leaves once the healthy data outweigh it.
-  if (!p_.guard || guard_suspended_) return false;
-  const auto in_memory = [this](std::uint64_t id) {
-    const Stored& st = stored_[id % kStored];
-    return st.id == id && st.in;
-  };
-  bool removed = false;
-  for (int iter = 0; iter < 8; ++iter) {
-    Mat2 At;
-    if (accepted_windows() < kMinJudge || !memory_estimate(&At)) break;
-    update_noise(At);
-    if (!(noise_.minCoeff() > 0)) break;
-    double worst = 0.0;
-    int j_worst = -1;
-    Mat2 r_worst = Mat2::Zero();
-    for (int j = 0; j < static_cast<int>(windows_.size()); ++j) {
-      const Batch& b = windows_[j];
-      if (!b.accepted || !in_memory(b.seg0) || !in_memory(b.seg1) || !(b.Z.determinant() > 0))
-        continue;
-      const Mat2 Zi = b.Z.inverse();
-      const Mat2 r = b.G - b.P * At;
-      double T = 0.0;
-      for (int i = 0; i < 2; ++i) T += r.col(i).dot(Zi * r.col(i)) / noise_(i);
-      if (T > worst) {
-        worst = T;
-        j_worst = j;
-        r_worst = r;
-      }
-    }
-    if (j_worst < 0 || !(worst > p_.guard_threshold)) break;
-    const Batch& b = windows_[j_worst];
-    const Mat2 D = (mem_.Pzq - b.P).inverse() * r_worst;  // the shift of A^ without it
-    double shift = 0.0;
-    for (int i = 0; i < 2; ++i) {
-      for (int k = 0; k < 2; ++k) {
-        shift = std::max(shift, std::abs(D(k, i)) / std::max(std::abs(At(k, i)), p_.settle_floor));
-      }
-    }
-    if (!(shift > p_.guard_min_shift)) break;
-    const std::uint64_t s0 = b.seg0, s1 = b.seg1;
-    remove_segment(s0);
-    remove_segment(s1);
-    for (Batch& w : windows_) {
-      if (w.seg0 == s0 || w.seg1 == s0 || w.seg0 == s1 || w.seg1 == s1) w.accepted = false;
-    }
-    ++est_.removed_windows;
-    settled_count_ = 0;
-    removed = true;
-  }
-  return removed;
-}
-
-void Identifier::remove_segment(std::uint64_t id) {
-  Stored& st = stored_[id % kStored];
-  if (st.id != id || !st.in) return;
-  mem_.remove(st.mem, std::exp(-p_.lambda * (clock_ - st.clock)));
-  st.in = false;
-}
-
 void Identifier::commit_mixing(bool rudder_iv) {
-  Mat2 P = mem_.Pqq, Yv = mem_.Yqm;
+  const KreisselmeierMemory& mem = guard_.memory();
+  Mat2 Phi = mem.Phi_ls, Y = mem.Y_ls;
   if (rudder_iv) {
     // Rescale the instruments' rows to the RMS of q's components (the identity only needs
     // an invertible row scaling).
     Vec2 sc;
     for (int i = 0; i < 2; ++i) {
-      sc(i) = mem_.Szz(i) > 0 ? std::sqrt(std::max(0.0, mem_.Pqq(i, i)) / mem_.Szz(i)) : 0.0;
+      sc(i) = mem.Szz(i) > 0 ? std::sqrt(std::max(0.0, mem.Phi_ls(i, i)) / mem.Szz(i)) : 0.0;
     }
-    P = sc.asDiagonal() * mem_.Pzq;
-    Yv = sc.asDiagonal() * mem_.Yzm;
+    Phi = sc.asDiagonal() * mem.Phi;
+    Y = sc.asDiagonal() * mem.Y;
   }
-  psi_ = P.determinant();
+  psi_ = Phi.determinant();
   Mat2 adj;
-  adj << P(1, 1), -P(0, 1), -P(1, 0), P(0, 0);
-  const Mat2 Z = adj * Yv;  // = psi A^T
+  adj << Phi(1, 1), -Phi(0, 1), -Phi(1, 0), Phi(0, 0);
+  const Mat2 Z = adj * Y;  // = psi A^T
   h_ << Z(0, 0), Z(1, 0), Z(0, 1), Z(1, 1);
-  // |det(int z q^T)| <= sqrt(Szz0 Szz1 Pqq00 Pqq11) (Hadamard, Cauchy-Schwarz), so this
-  // lies in [0, 1]; for z = q it is psi / (Phi00 Phi11) = 1 - (correlation of q1, q2)^2.
-  scale_ = mem_.Pqq(0, 0) * mem_.Pqq(1, 1);
+  // |det(int z q^T)| <= sqrt(Szz0 Szz1 Phi_ls00 Phi_ls11) (Hadamard, Cauchy-Schwarz), so
+  // this lies in [0, 1]; for z = q it is psi / (Phi00 Phi11) = 1 - (correlation of q1, q2)^2.
+  scale_ = mem.Phi_ls(0, 0) * mem.Phi_ls(1, 1);
   est_.excitation = scale_ > 0 ? std::clamp(std::abs(psi_) / scale_, 0.0, 1.0) : 0.0;
 }
 
 void Identifier::update_std_error() {
-  // Row i of A^ is off by Pzq^-1 sum w z e_i: Cov_i = Pzq^-1 V_i Pzq^-T, with V_i = (the
+  // Row i of A^ is off by Phi^-1 sum w z e_i: Cov_i = Phi^-1 V_i Phi^-T, with V_i = (the
   // recent rate of Var(b_i)) x (the memory's sum of squared weights), from the last
-  // kStdBatches accepted windows (tapered batch sums b = G - P A^T, see Estimate::std_error).
+  // kStdBatches accepted windows (tapered batch sums b = Y - Phi A^T, see
+  // Estimate::std_error).
+  const KreisselmeierMemory& mem = guard_.memory();
   Mat2 At;
-  if (!memory_estimate(&At)) return;
+  if (!mem.estimate(&At)) return;
   std::array<Mat2, 2> R{Mat2::Zero(), Mat2::Zero()};
   double T = 0.0;
   int n = 0;
-  for (auto it = windows_.rbegin(); it != windows_.rend() && n < kStdBatches; ++it) {
+  const auto& windows = guard_.windows();
+  for (auto it = windows.rbegin(); it != windows.rend() && n < kStdBatches; ++it) {
     if (!it->accepted) continue;
-    const Mat2 b = it->G - it->P * At;  // column i: tapered sum of z e_i over the batch
+    const Mat2 b = it->Y - it->Phi * At;  // column i: tapered sum of z e_i over the batch
     for (int i = 0; i < 2; ++i) R[i] += b.col(i) * b.col(i).transpose();
     T += it->H2;  // Var(b_j) = (long-run variance rate) x int h^4 dt
     ++n;
   }
-  if (n < kMinBatches) return;
-  const Mat2 Pinv = mem_.Pzq.inverse();
+  if (n < ConsistencyGuard::kMinBatches) return;
   // The b_j sum to ~0 over the memory (A^ solves its normal equations), so n batches carry
   // n - 2 degrees of freedom per row: scale by n / (n - 2).
   const double dof = n / std::max(1.0, n - 2.0);
   std_error_dof_ = n - 2.0;
+  const Mat2 Pinv = mem.Phi.inverse();
   for (int i = 0; i < 2; ++i) {
-    const Mat2 C = Pinv * (R[i] * (dof * mem_.W2 / T)) * Pinv.transpose();
+    const Mat2 C = Pinv * (R[i] * (dof * mem.W2 / T)) * Pinv.transpose();
     for (int j = 0; j < 2; ++j) est_.std_error(2 * i + j) = std::sqrt(std::max(0.0, C(j, j)));
     row_cov_[i] = C;
   }
@@ -721,7 +379,7 @@ double Identifier::relative_std_error(const Vec4& a) const {
   }
   for (int i = 0; i < 2; ++i) {
     // E[(da_i^T q)^2] = tr(Cov_i Q) over the memory (Q: its sum of q q^T).
-    const double err = std::sqrt(upper2 * (row_cov_[i] * mem_.Pqq).trace());
+    const double err = std::sqrt(upper2 * (row_cov_[i] * guard_.memory().Phi_ls).trace());
     const double r = err / prediction_scale(a, i);
     worst = std::isnan(r) ? std::numeric_limits<double>::infinity() : std::max(worst, r);
   }
@@ -731,7 +389,7 @@ double Identifier::relative_std_error(const Vec4& a) const {
 double Identifier::prediction_scale(const Vec4& a, int i) const {
   // The RMS of each term a_ij q_j, added: the terms of a_i^T q may cancel (in a steady turn
   // A x = -B delta), and a relative error must not grow with that cancellation.
-  const Mat2& Q = mem_.Pqq;
+  const Mat2& Q = guard_.memory().Phi_ls;
   const double floor = p_.settle_floor * std::sqrt(Q.trace());
   const double s = std::abs(a(2 * i)) * std::sqrt(std::max(0.0, Q(0, 0))) +
                    std::abs(a(2 * i + 1)) * std::sqrt(std::max(0.0, Q(1, 1)));
@@ -748,7 +406,8 @@ double Identifier::relative_prediction_change(const Vec4& d, const Vec4& a) cons
   }
   for (int i = 0; i < 2; ++i) {
     const Vec2 di(d(2 * i), d(2 * i + 1));
-    const double r = std::sqrt(std::max(0.0, di.dot(mem_.Pqq * di))) / prediction_scale(a, i);
+    const double r =
+        std::sqrt(std::max(0.0, di.dot(guard_.memory().Phi_ls * di))) / prediction_scale(a, i);
     worst = std::isnan(r) ? std::numeric_limits<double>::infinity() : std::max(worst, r);
   }
   return worst;
@@ -775,9 +434,7 @@ void Identifier::update_convergence(double t) {
   }
   // Nothing converges on data the guard keeps out, nor while it keeps data out, nor before
   // it can judge (with the guard on).
-  const bool guarded = p_.guard && p_.method == IdentMethod::kKreisselmeier;
-  const bool consistent =
-      est_.consistent && inconsistent_run_ == 0.0 && (!guarded || accepted_windows() >= kMinJudge);
+  const bool consistent = guard_.consistent();
   const bool excited = est_.excitation >= p_.min_excitation &&
                        est_.time_constant <= p_.settle_window * p_.settle_windows;
   settled_count_ =

@@ -1,5 +1,7 @@
 #include "usv_fdi/core/isolation.hpp"
 
+#include "usv_fdi/core/robust.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,23 +25,6 @@ void prune(std::deque<double>* q, double t_min) {
 }
 void prune(std::deque<std::pair<double, double>>* q, double t_min) {
   while (!q->empty() && q->front().first < t_min) q->pop_front();
-}
-
-double median(std::vector<double>* v) {
-  if (v->empty()) return 0.0;
-  auto mid = v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2);
-  std::nth_element(v->begin(), mid, v->end());
-  return *mid;
-}
-
-/// 1.4826 * median absolute deviation: the standard deviation for Gaussian data, robust to
-/// outliers and to a fault covering less than half of the data.
-double robust_std(std::vector<double>* v) {
-  if (v->size() < 2) return 0.0;
-  const double m = median(v);
-  std::vector<double> dev(v->size());
-  for (std::size_t i = 0; i < v->size(); ++i) dev[i] = std::abs((*v)[i] - m);
-  return 1.4826 * median(&dev);
 }
 
 /// Time after a restart from the measurements until the restart's transient has faded
@@ -235,7 +220,7 @@ void Isolator::set_estimate(const Estimate& est) {
 }
 
 double Isolator::learned_threshold(std::vector<double>* healthy) const {
-  const double med = median(healthy);
+  const double med = median_in_place(healthy);
   const double sd = robust_std(healthy);
   std::sort(healthy->begin(), healthy->end());
   const double q999 = healthy->empty() ? 0.0 : (*healthy)[healthy->size() * 999 / 1000];

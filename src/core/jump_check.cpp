@@ -1,5 +1,7 @@
 #include "usv_fdi/core/jump_check.hpp"
 
+#include "usv_fdi/core/robust.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -332,8 +334,7 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
     if (++dt_seen_ < kIntervalSamples) return v;
     std::vector<double> d(first_t_.size() - 1);
     for (std::size_t i = 0; i < d.size(); ++i) d[i] = first_t_[i + 1] - first_t_[i];
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    dt_ = d[d.size() / 2];
+    dt_ = median_in_place(&d);
     std::vector<double>().swap(first_t_);
     if (!(dt_ > 0)) {
       dt_seen_ = 0;

@@ -47,27 +47,8 @@
 // steers on the measured yaw rate feeds a filtered trace of the gyro noise back into
 // delta, and with it a (much smaller, second-order) correlation into the instruments.
 //
-// Consistency guard. The regression uses the measured y, so a sensor fault corrupts the
-// memory, and before the isolation thread is armed nothing else sees it: a 10-sigma bias
-// of 10 s drove A^ to nonsense that 200 s of healthy data did not undo. No model is needed
-// to notice: m = A q holds for one A on all healthy data, and a fault breaks it. The memory
-// is therefore built from segments of half a window (5 / eps1 s); every sample lies in two
-// Hann-tapered windows half a window apart, and a segment enters the memory only when both
-// windows that cover it are consistent with the memory: the window's equation-error sums
-// r_i = int h z (m_i - a^_i q) against their covariance s_i (int h^2 z z^T + P Cov(a^_i)
-// P^T), s_i the equation error's long-run variance density (the median over the accepted
-// windows, robust to a few bad ones), Cov(a^_i) the memory's own uncertainty: chi-square
-// with 4 degrees of freedom on healthy data, hundreds to thousands under a sensor fault.
-// The estimate converges neither while data are kept out nor before the guard can judge
-// (kMinJudge windows). A fault may still enter before that, or be present from the start:
-// (1) each accepted window is judged again against the memory as it grows, and one that
-// disagrees with the rest is taken out (the memory is linear in its segments); (2) before
-// convergence, the estimate from the last guard_recent_time alone is compared with the
-// memory's (a Wald test): when the recent data agree among themselves and contradict the
-// memory, the memory is rebuilt from them. A fault present from the start and never
-// ending cannot be told from the vessel (a constant bias is a constant disturbance): the
-// estimate does not converge while the data contradict each other, and says why
-// (IdentStatus::kInconsistent).
+// Consistency guard: core/consistency_guard.hpp (the memory is built from segments that
+// agree with it; docs/design.md section 8.1).
 #pragma once
 
 #include <array>
@@ -75,6 +56,7 @@
 #include <deque>
 #include <vector>
 
+#include "usv_fdi/core/consistency_guard.hpp"
 #include "usv_fdi/core/filters.hpp"
 #include "usv_fdi/core/speed.hpp"
 #include "usv_fdi/core/types.hpp"
@@ -294,84 +276,11 @@ class Identifier {
   double t_aux_ = kNaN;        ///< time A_aux_ was last refreshed
   Vec2 x_aux_ = Vec2::Zero();  ///< kept across filter restarts (it depends on delta only)
   Vec2 z_ = Vec2::Zero();
-  // Kreisselmeier memories (weights e^{-lambda (t - s)}; Zm and W2 with their squares):
-  // least squares (int q q^T, int q m^T), which also gives A_aux and the scale of q, and the
-  // instruments' int z q^T, int z m^T, diag int z z^T (z = q for the regressor instruments).
-  struct Memory {
-    Mat2 Pqq = Mat2::Zero(), Yqm = Mat2::Zero();
-    Mat2 Pzq = Mat2::Zero(), Yzm = Mat2::Zero();
-    Mat2 Zm = Mat2::Zero();  ///< int w^2 z z^T: Cov(row i of A^) = s_i Pzq^-1 Zm Pzq^-T
-    Vec2 Szz = Vec2::Zero();
-    double W2 = 0.0;     ///< the memory's sum of squared weights [s]
-    double decay = 1.0;  ///< a segment's own decay over its length, exp(-lambda len)
-    double len = 0.0;    ///< a segment's length [s]
-    void step(double E, double dt, const Vec2& q, const Vec2& m, const Vec2& z);
-    /// this <- this decayed over the segment's length, plus the segment.
-    void append(const Memory& seg);
-    /// this <- this minus the segment, decayed by E since it was appended.
-    void remove(const Memory& seg, double E);
-  };
-  // The memory is a sum of segments (half a window each), every one judged before it
-  // enters (a pending segment waits for the windows that cover it) and kept, so that one
-  // found inconsistent later can be taken out again exactly (the memory is linear in them).
-  Memory mem_;          ///< the memory the estimate comes from (committed segments only)
-  double clock_ = 0.0;  ///< the memory's clock: committed data so far [s]
-  Memory seg_;          ///< the segment being summed
-  std::uint64_t next_seg_ = 0;
-  struct Pending {
-    Memory mem;
-    std::uint64_t id = 0;
-    int needed = 2;  ///< verdicts needed (1 for the first segment after a restart)
-    int votes = 0;
-    bool bad = false;
-  };
-  std::deque<Pending> pending_;
-  bool first_segment_ = true;  ///< the segment being summed is the first since a restart
-  struct Stored {
-    Memory mem;
-    std::uint64_t id = ~std::uint64_t{0};
-    double clock = 0.0;  ///< the memory's clock when it was committed
-    bool in = false;     ///< part of the memory
-  };
-  static constexpr int kStored = 176;  ///< closed segments kept (> 2 kWindows: 440 s)
-  std::vector<Stored> stored_;         ///< ring by id, accepted or rejected
-  // The windows: Hann-tapered sums over two segments, two of them half a window apart, so
-  // that every sample is judged with the full weight sin^2 + cos^2 = 1. Each accepted
-  // window is a batch for the noise level, the standard errors and the later re-judging.
-  struct Batch {
-    Mat2 P = Mat2::Zero();  ///< int h z q^T
-    Mat2 G = Mat2::Zero();  ///< int h z m^T
-    Mat2 Z = Mat2::Zero();  ///< int h^2 z z^T
-    double H2 = 0.0;        ///< int h^2 dt
-    double T = 0.0;         ///< time since the window began [s]
-    int segs = 0;           ///< segments closed since it began
-    bool active = false;
-    std::uint64_t seg0 = 0, seg1 = 0;  ///< the segments it covers
-    double clock = 0.0;                ///< the memory's clock when it was judged
-    double t_end = 0.0;                ///< time it was judged [s]
-    bool accepted = false;             ///< passed, and no covered segment was rejected
-  };
-  static constexpr int kWindows = 128;         ///< ~ the memory's length (320 s at eps1 = 1)
-  static constexpr int kMinBatches = 3;        ///< no standard error from fewer batches
-  static constexpr int kStdBatches = 20;       ///< standard errors from the latest batches
-  static constexpr int kMinJudge = 6;          ///< no verdict from fewer batches
-  static constexpr double kBatchLength = 5.0;  ///< batch length x eps1 [-]
-  std::array<Batch, 2> open_;                  ///< the two windows being summed
-  std::deque<Batch> windows_;                  ///< judged windows, oldest first
-  double inconsistent_run_ = 0.0;  ///< rejected data since the last accepted segment [s]
-  bool guard_suspended_ = false;   ///< after guard_recent_time past convergence
-  bool supervised_ = false;        ///< see set_supervised
-  Vec2 noise_ = Vec2::Zero();      ///< robust noise level s_i per row (0: not known)
+  // The Kreisselmeier memory, built from judged segments (core/consistency_guard.hpp).
+  ConsistencyGuard guard_;
+  static constexpr int kStdBatches = 20;  ///< standard errors from the latest windows
+  bool supervised_ = false;               ///< see set_supervised
   void step_memories(double t, double dt, bool rudder_iv);
-  void close_segment(double t, bool rudder_iv);
-  bool check_memory(double t);
-  int accepted_windows() const;
-  /// The memory's estimate A^T (column i: row i of A); false when it has none.
-  bool memory_estimate(Mat2* At) const;
-  void update_noise(const Mat2& At);
-  bool judge(const Batch& b);
-  bool rejudge();
-  void remove_segment(std::uint64_t id);
   void commit_mixing(bool rudder_iv);
   void update_std_error();
   /// The largest upper-bound relative standard error (inf while there are none):
