@@ -69,12 +69,7 @@ void KreisselmeierMemory::append(const KreisselmeierMemory& seg) {
   W2 = E2 * W2 + seg.W2;
 }
 
-bool KreisselmeierMemory::estimate(Mat2* At) const {
-  const double det = Phi.determinant();
-  if (!std::isfinite(det) || !(std::abs(det) > 0)) return false;
-  *At = Phi.inverse() * Y;
-  return At->allFinite();
-}
+bool KreisselmeierMemory::estimate(Mat2* At) const { return solve(Phi, Y, At); }
 
 bool GuardWindow::chi2(const Mat2& At, Vec2* q) const {
   if (!(Z.determinant() > 0)) return false;

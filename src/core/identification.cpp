@@ -335,9 +335,10 @@ void Identifier::update_std_error() {
   // n - 2 degrees of freedom per row: scale by n / (n - 2).
   const double dof = n / std::max(1.0, n - 2.0);
   std_error_dof_ = n - 2.0;
-  const Mat2 Pinv = mem.Phi.inverse();
+  const auto lu = mem.Phi.partialPivLu();
   for (int i = 0; i < 2; ++i) {
-    const Mat2 C = Pinv * (R[i] * (dof * mem.W2 / T)) * Pinv.transpose();
+    const Mat2 G = lu.solve(R[i] * (dof * mem.W2 / T));  // Phi^-1 V_i
+    const Mat2 C = lu.solve(G.transpose());              // Phi^-1 V_i Phi^-T (V_i symmetric)
     for (int j = 0; j < 2; ++j) est_.std_error(2 * i + j) = std::sqrt(std::max(0.0, C(j, j)));
     row_cov_[i] = C;
   }
