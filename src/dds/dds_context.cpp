@@ -4,7 +4,9 @@
 #include <string>
 #include <utility>
 
+#include <fastrtps/attributes/LibrarySettingsAttributes.h>
 #include <fastrtps/types/TypesBase.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
@@ -107,6 +109,15 @@ DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
   } else {
     load_profiles_file(config_.profiles_file);
   }
+
+  // Participants of one process (the sidecar has two: acks arrive on their own) would hand
+  // each other discovery data by pointer, and Fast DDS 2.9 may then touch a reader of a
+  // participant already deleted: the sidecar crashed in StatefulWriter::intraprocess_gap
+  // while deleting its readers at SIGTERM, a few times in a hundred on a loaded machine.
+  // With intraprocess delivery off they meet over the transports, like two processes.
+  eprosima::fastrtps::LibrarySettingsAttributes library;
+  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
 
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   peers_ = std::make_unique<PeerDirectory>();

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fastdds/dds/core/condition/WaitSet.hpp>
@@ -235,6 +236,29 @@ TEST(XmlProfiles, EveryProfileCreatesAnEndpoint) {
   }
   const auto errors = ErrorCollector::take();
   EXPECT_TRUE(errors.empty()) << join(errors);
+}
+
+TEST(DdsContext, TwoContextsOfOneProcessAreDeletedWithoutACrash) {
+  // The sidecar's shape: one participant with the INS, rudder and fault-event endpoints, a
+  // second one of its own for the acks, deleted ack participant first while discovery
+  // between the two may still be under way. With Fast DDS's intraprocess delivery the
+  // first participant's discovery writer could then hand a gap to the deleted
+  // participant's reader (a crash in StatefulWriter::intraprocess_gap, a few times in a
+  // hundred sidecar stops on a loaded machine); DdsContext turns intraprocess delivery off.
+  for (int i = 0; i < 40; ++i) {
+    SCOPED_TRACE(i);
+    const DdsConfig c = test_config();
+    auto main = std::make_unique<DdsContext>(c);
+    main->create_reader(TopicId::kIns, profiles::kInsReaderReliable);
+    main->create_reader(TopicId::kRudder, profiles::kRudderReaderReliable);
+    main->create_writer(TopicId::kFaultEvent, profiles::kFaultEventWriter);
+    main->create_reader(TopicId::kFaultEvent, profiles::kFaultEventReader);
+    auto acks = std::make_unique<DdsContext>(c);
+    acks->create_reader(TopicId::kFaultAck, profiles::kFaultAckReader);
+    std::this_thread::sleep_for(std::chrono::milliseconds(i % 8));
+    acks.reset();
+    main.reset();
+  }
 }
 
 TEST(DdsContext, FailuresNameWhatFailed) {
