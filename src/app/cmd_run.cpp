@@ -158,9 +158,8 @@ void log_line(int level, const std::string& msg) {
 }
 
 int run_service(const RunArgs& a, const AsyncLogging& logging) {
-  // SIGINT/SIGTERM are blocked before any DDS or pipeline thread exists and received with
-  // sigtimedwait below: no signal handler, so nothing runs in signal context.
-  block_stop_signals();
+  // SIGINT/SIGTERM are blocked (run_service_logged) before any thread exists and received
+  // with sigtimedwait below: no signal handler, so nothing runs in signal context.
   route_fastdds_log_to_spdlog();
   service::ServiceConfig cfg;
   try {
@@ -266,6 +265,10 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
 constexpr double kLogDrainAtExit = 2.0;
 
 int run_service_logged(const RunArgs& a) {
+  // Blocked before the logging thread exists too: a thread that does not block SIGTERM may
+  // be the one the kernel hands it to, and its default action ends the process (exit 143,
+  // nothing saved; once in about a hundred stops on a loaded machine).
+  block_stop_signals();
   AsyncLogging logging;
   const int code = run_service(a, logging);
   // Everything is stopped and saved; only the log may be stuck behind an unread stderr.
