@@ -114,9 +114,11 @@ DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
   // each other discovery data by pointer, and Fast DDS 2.9 may then touch a reader of a
   // participant already deleted: the sidecar crashed in StatefulWriter::intraprocess_gap
   // while deleting its readers at SIGTERM, a few times in a hundred on a loaded machine.
-  // With intraprocess delivery off they meet over the transports, like two processes.
+  // Discovery between them goes over the transports, like between two processes; user data
+  // still goes by pointer (with intraprocess delivery off altogether, participants of one
+  // process no longer receive each other's samples).
   eprosima::fastrtps::LibrarySettingsAttributes library;
-  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_USER_DATA_ONLY;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
 
   auto* factory = fdds::DomainParticipantFactory::get_instance();

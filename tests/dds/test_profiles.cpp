@@ -244,7 +244,8 @@ TEST(DdsContext, TwoContextsOfOneProcessAreDeletedWithoutACrash) {
   // between the two may still be under way. With Fast DDS's intraprocess delivery the
   // first participant's discovery writer could then hand a gap to the deleted
   // participant's reader (a crash in StatefulWriter::intraprocess_gap, a few times in a
-  // hundred sidecar stops on a loaded machine); DdsContext turns intraprocess delivery off.
+  // hundred sidecar stops on a loaded machine); DdsContext sends discovery between
+  // participants of one process over the transports.
   for (int i = 0; i < 40; ++i) {
     SCOPED_TRACE(i);
     const DdsConfig c = test_config();
