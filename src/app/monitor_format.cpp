@@ -13,21 +13,12 @@ namespace usvfdi::app {
 
 std::string json_row(const Row& r, double heard_age, double now) {
   std::ostringstream os;
-  const FaultEvent& e = r.ev;
-  os << "{\"type\":\"fault\",\"mmsi\":" << r.mmsi << ",\"sensor\":\"" << to_string(e.sensor)
-     << "\",\"state\":\"" << to_string(e.state) << "\",\"kind\":\"" << to_string(e.kind)
-     << "\",\"c_a\":" << io::json_number(e.c_a) << ",\"c_g\":" << io::json_number(e.c_g)
-     << ",\"statistic\":" << io::json_number(e.statistic)
-     << ",\"threshold\":" << io::json_number(e.threshold)
-     << ",\"onset_time\":" << io::json_number(e.onset_time)
-     << ",\"detection_time\":" << io::json_number(e.detection_time)
-     << ",\"stamp\":" << io::json_number(e.t) << ",\"sequence\":" << e.sequence << ",\"a\":["
-     << io::json_number(e.A(0, 0)) << "," << io::json_number(e.A(0, 1)) << ","
-     << io::json_number(e.A(1, 0)) << "," << io::json_number(e.A(1, 1))
-     << "],\"age_s\":" << io::json_number(now - r.written)
+  FaultEvent shown = r.ev;
+  shown.message = escape_text(shown.message);
+  os << "{\"type\":\"fault\",\"mmsi\":" << r.mmsi << "," << io::fault_event_fields(shown)
+     << ",\"age_s\":" << io::json_number(now - r.written)
      << ",\"heard_age_s\":" << io::json_number(heard_age)
-     << ",\"alive\":" << (r.alive ? "true" : "false")
-     << ",\"message\":" << io::json_string(escape_text(e.message)) << "}";
+     << ",\"alive\":" << (r.alive ? "true" : "false") << "}";
   return os.str();
 }
 

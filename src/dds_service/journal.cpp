@@ -145,17 +145,7 @@ std::string StateJournal::serialise(std::uint32_t mmsi, const std::vector<FaultE
   for (std::size_t i = 0; i < events.size(); ++i) {
     const FaultEvent& e = events[i];
     s += i == 0 ? "\n" : ",\n";
-    s += "    {\"sensor\": \"" + std::string(to_string(e.sensor)) + "\", \"state\": \"" +
-         to_string(e.state) + "\", \"kind\": \"" + to_string(e.kind) +
-         "\", \"sequence\": " + std::to_string(e.sequence) +
-         ", \"incarnation\": " + std::to_string(e.incarnation) +
-         ",\n     \"c_a\": " + number(e.c_a) + ", \"c_g\": " + number(e.c_g) +
-         ", \"statistic\": " + number(e.statistic) + ", \"threshold\": " + number(e.threshold) +
-         ",\n     \"onset_time\": " + number(e.onset_time) +
-         ", \"detection_time\": " + number(e.detection_time) + ", \"stamp\": " + number(e.t) +
-         ",\n     \"a\": [" + number(e.A(0, 0)) + ", " + number(e.A(0, 1)) + ", " +
-         number(e.A(1, 0)) + ", " + number(e.A(1, 1)) +
-         "],\n     \"message\": " + io::json_string(e.message) + "}";
+    s += "    {" + io::fault_event_fields(e, 17) + "}";
   }
   s += events.empty() ? "],\n" : "\n  ],\n";
   return s + kChecksumLine + hex64(fnv1a64(s)) + "\"\n}\n";

@@ -111,23 +111,31 @@ std::string json_string_array(const std::string& names, const char* separator) {
   return out + "]";
 }
 
-std::string json_number(double x) {
+std::string json_number(double x) { return json_number(x, 9); }
+
+std::string json_number(double x, int digits) {
   if (!std::isfinite(x)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", x);
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
   return buf;
 }
 
+std::string fault_event_fields(const FaultEvent& e, int digits) {
+  const auto num = [digits](double x) { return json_number(x, digits); };
+  return "\"sensor\":" + json_string(to_string(e.sensor)) +
+         ",\"state\":" + json_string(to_string(e.state)) +
+         ",\"kind\":" + json_string(to_string(e.kind)) +
+         ",\"sequence\":" + std::to_string(e.sequence) +
+         ",\"incarnation\":" + std::to_string(e.incarnation) + ",\"c_a\":" + num(e.c_a) +
+         ",\"c_g\":" + num(e.c_g) + ",\"statistic\":" + num(e.statistic) +
+         ",\"threshold\":" + num(e.threshold) + ",\"onset_time\":" + num(e.onset_time) +
+         ",\"detection_time\":" + num(e.detection_time) + ",\"stamp\":" + num(e.t) + ",\"a\":[" +
+         num(e.A(0, 0)) + "," + num(e.A(0, 1)) + "," + num(e.A(1, 0)) + "," + num(e.A(1, 1)) +
+         "],\"message\":" + json_string(e.message);
+}
+
 void JsonlWriter::event(const FaultEvent& e) {
-  out_ << "{\"type\":\"event\",\"t\":" << json_number(e.t)
-       << ",\"sensor\":" << json_string(to_string(e.sensor))
-       << ",\"state\":" << json_string(to_string(e.state))
-       << ",\"kind\":" << json_string(to_string(e.kind)) << ",\"c_a\":" << json_number(e.c_a)
-       << ",\"c_g\":" << json_number(e.c_g) << ",\"statistic\":" << json_number(e.statistic)
-       << ",\"threshold\":" << json_number(e.threshold)
-       << ",\"onset_time\":" << json_number(e.onset_time)
-       << ",\"detection_time\":" << json_number(e.detection_time) << ",\"sequence\":" << e.sequence
-       << ",\"a\":" << array4(to_params(e.A)) << ",\"message\":" << json_string(e.message) << "}\n";
+  out_ << "{\"type\":\"event\"," << fault_event_fields(e) << "}\n";
 }
 
 void JsonlWriter::mismatch(double t, bool active, const std::string& reason) {

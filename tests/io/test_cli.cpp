@@ -111,8 +111,9 @@ TEST_F(Cli, SimThenReplayWritesWellFormedRecords) {
       EXPECT_EQ(v.at("a").arr.size(), 4u);
       EXPECT_EQ(v.at("converged").kind, js::Value::kBool);
     } else if (type == "event") {
-      for (const char* k : {"t", "sensor", "state", "kind", "c_a", "c_g", "statistic", "threshold",
-                            "onset_time", "detection_time", "sequence", "a", "message"}) {
+      for (const char* k :
+           {"stamp", "sensor", "state", "kind", "sequence", "incarnation", "c_a", "c_g",
+            "statistic", "threshold", "onset_time", "detection_time", "a", "message"}) {
         EXPECT_TRUE(v.has(k)) << k;
       }
     } else {

@@ -83,7 +83,7 @@ TEST(Replay, CsvReplayGivesTheEventsOfTheInMemoryRun) {
   ASSERT_EQ(events.size(), want.size());
   EXPECT_GT(want.size(), 0u) << "the stale gyro should raise an event";
   for (std::size_t i = 0; i < want.size(); ++i) {
-    EXPECT_EQ(events[i].at("t").num, std::stod(json_number(want[i].t)));
+    EXPECT_EQ(events[i].at("stamp").num, std::stod(json_number(want[i].t)));
     EXPECT_EQ(events[i].at("sensor").str, to_string(want[i].sensor));
     EXPECT_EQ(events[i].at("state").str, to_string(want[i].state));
     EXPECT_EQ(events[i].at("kind").str, to_string(want[i].kind));
@@ -176,10 +176,10 @@ TEST(Replay, InputErrorKeepsEverythingProducedBefore) {
   EXPECT_NE(error.find("'oops'"), std::string::npos) << error;
   std::vector<double> want, got;
   for (const js::Value& v : full) {
-    if (v.at("type").str == "event" && v.at("t").num < 50.0) want.push_back(v.at("t").num);
+    if (v.at("type").str == "event" && v.at("stamp").num < 50.0) want.push_back(v.at("stamp").num);
   }
   for (const js::Value& v : part) {
-    if (v.at("type").str == "event") got.push_back(v.at("t").num);
+    if (v.at("type").str == "event") got.push_back(v.at("stamp").num);
   }
   EXPECT_FALSE(want.empty());
   EXPECT_EQ(got, want);

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "usv_fdi/dds_service/journal.hpp"
+#include "usv_fdi/io/jsonl.hpp"
 
 namespace usvfdi::service {
 namespace {
@@ -125,6 +126,36 @@ TEST(StateJournal, RoundTripIsExactIncludingNaNAndStrings) {
   EXPECT_TRUE(out.events.empty());
 }
 
+TEST(StateJournal, AFileOfThePreviousLayoutIsRead) {
+  // Written by the version before the one serialisation of a FaultEvent (its fields spread
+  // over three lines with spaces after the colons): a vessel's state survives the upgrade.
+  std::string body =
+      "{\n  \"format\": \"usv-fdi fault state\",\n  \"version\": 1,\n  \"mmsi\": 257000009,\n"
+      "  \"written\": 1795449401.5,\n  \"instances\": [\n"
+      "    {\"sensor\": \"gyro\", \"state\": \"raised\", \"kind\": \"bias\", \"sequence\": 3, "
+      "\"incarnation\": 17,\n"
+      "     \"c_a\": 0.25, \"c_g\": 0.96875, \"statistic\": 14.5, \"threshold\": 6,\n"
+      "     \"onset_time\": 20, \"detection_time\": 20.5, \"stamp\": 21.5,\n"
+      "     \"a\": [-0.5, 0.25, 0.125, -1], \"message\": \"gyro bias\"}\n  ],\n";
+  const std::string text = body + "  \"checksum\": \"fnv1a64:" + fnv(body) + "\"\n}\n";
+  StateJournal::Contents out;
+  std::string err;
+  ASSERT_TRUE(StateJournal::parse(text, 257000009, &out, &err)) << err;
+  ASSERT_EQ(out.events.size(), 1u);
+  const FaultEvent& e = out.events[0];
+  EXPECT_EQ(e.sensor, Sensor::kGyro);
+  EXPECT_EQ(e.state, FaultState::kRaised);
+  EXPECT_EQ(e.sequence, 3u);
+  EXPECT_EQ(e.incarnation, 17u);
+  EXPECT_EQ(e.c_g, 0.96875);
+  EXPECT_EQ(e.t, 21.5);
+  EXPECT_EQ(e.A(1, 1), -1.0);
+  EXPECT_EQ(e.message, "gyro bias");
+  // And what this version writes is one line per instance, the replay's and monitor's form.
+  const std::string now = StateJournal::serialise(257000009, out.events, 1795449402.0);
+  EXPECT_NE(now.find("    {" + io::fault_event_fields(e, 17) + "}\n"), std::string::npos) << now;
+}
+
 TEST(StateJournal, RecordReplacesTheFileAtomicallyAndKeepsTheLatestOfEachInstance) {
   TempDir d;
   const std::string path = StateJournal::path_for(d.path, 257000002);
@@ -222,17 +253,16 @@ TEST(StateJournal, BadFilesAreRefusedWithWhatIsWrong) {
        "\"format\" is \"something else\""},
       {"other vessel", edit_and_resign(good, "257000003", "257000004"),
        "the file is for MMSI 257000004, this sidecar watches 257000003"},
-      {"unknown field", edit_and_resign(good, "\"kind\"", "\"colour\": 1, \"kind\""),
+      {"unknown field", edit_and_resign(good, "\"kind\"", "\"colour\":1,\"kind\""),
        "unknown field \"colour\""},
       {"sensor", edit_and_resign(good, "\"gyro\"", "\"compass\""), "unknown sensor \"compass\""},
       {"state", edit_and_resign(good, "\"raised\"", "\"panicking\""),
        "unknown state \"panicking\""},
-      {"sequence", edit_and_resign(good, "\"sequence\": 3", "\"sequence\": -3"),
+      {"sequence", edit_and_resign(good, "\"sequence\":3", "\"sequence\":-3"),
        "\"sequence\" = -3 is not a non-negative integer"},
-      {"missing", edit_and_resign(good, "\"c_a\": 0.10000000000000001, ", ""),
-       "\"c_a\" is missing"},
-      {"a", edit_and_resign(good, "\"a\": [", "\"a\": [1, "), "\"a\" must be a list of 4"},
-      {"number", edit_and_resign(good, "\"threshold\": 6", "\"threshold\": \"six\""),
+      {"missing", edit_and_resign(good, "\"c_a\":0.10000000000000001,", ""), "\"c_a\" is missing"},
+      {"a", edit_and_resign(good, "\"a\":[", "\"a\":[1,"), "\"a\" must be a list of 4"},
+      {"number", edit_and_resign(good, "\"threshold\":6", "\"threshold\":\"six\""),
        "\"threshold\" = six is not a number"},
       {"syntax", edit_and_resign(good, "\"instances\": [", "\"instances\": [[}"),
        "not valid JSON at line"},

@@ -17,10 +17,12 @@
 //     "mmsi": 257000001,
 //     "written": 1732370000.123,
 //     "instances": [
-//       {"sensor": "gyro", "state": "raised", "kind": "bias", "sequence": 3,
-//        "incarnation": 1764624000123456, "c_a": 0.01,
-//        "c_g": 0.99, "statistic": 14.1, "threshold": 6, "onset_time": 20, "detection_time": 20.4,
-//        "stamp": 20.4, "a": [-0.1, 0.2, 0.3, -0.4], "message": "..."}
+//       {"sensor":"gyro","state":"raised","kind":"bias","sequence":3,
+//        "incarnation":1764624000123456,"c_a":0.01,"c_g":0.99,"statistic":14.1,"threshold":6,
+//        "onset_time":20,"detection_time":20.4,"stamp":20.4,"a":[-0.1,0.2,0.3,-0.4],
+//        "message":"..."}   (one line each: io::fault_event_fields, as the replay and the
+//                            monitor write a fault event; files of earlier versions, with
+//                            the same fields spread over three lines, are read alike)
 //     ],
 //     "checksum": "fnv1a64:0123456789abcdef"
 //   }

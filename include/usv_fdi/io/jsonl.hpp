@@ -1,9 +1,6 @@
 // JSON Lines output of a replay: one JSON object per line, each with a "type" field.
 //
-//   {"type":"event","t":..,"sensor":"accelerometer"|"gyro"|"unknown",
-//    "state":"raised"|"cleared"|"active_acknowledged"|"acknowledged","kind":"bias"|..,
-//    "c_a":..,"c_g":..,"statistic":..,"threshold":..,"onset_time":..,"detection_time":..,
-//    "sequence":n,"a":[a1,a2,a3,a4],"message":".."}
+//   {"type":"event",<the fault event's fields, fault_event_fields()>}
 //   {"type":"estimate","t":..,"a":[a1,a2,a3,a4],"converged":bool,"excitation":..,"armed":bool}
 //   {"type":"summary","samples":n,"rejected":n,"events":n,
 //    "raised":{"accelerometer":n,"gyro":n,"unknown":n},"final_a":[..],"converged":bool,
@@ -27,6 +24,20 @@ namespace usvfdi::io {
 std::string json_string(const std::string& s);
 /// A JSON number with %.9g, or null when x is not finite.
 std::string json_number(double x);
+/// A JSON number with `digits` significant digits (%.*g), or null when x is not finite.
+std::string json_number(double x, int digits);
+
+/// A fault event's fields as JSON members, without the braces, in this order:
+///   "sensor":"accelerometer"|"gyro"|"unknown",
+///   "state":"normal"|"raised"|"active_acknowledged"|"cleared"|"acknowledged",
+///   "kind":"bias"|.., "sequence":n, "incarnation":n, "c_a":.., "c_g":.., "statistic":..,
+///   "threshold":.., "onset_time":.., "detection_time":.., "stamp":.. (the event's own time,
+///   FaultEvent::t), "a":[a1,a2,a3,a4], "message":".."
+/// The one serialisation of a FaultEvent: the replay's event records, the sidecar's state
+/// journal and `usv-fdi monitor --json` all write it (numbers with `digits` significant
+/// digits: 9, or 17 where the value must survive a round trip).
+std::string fault_event_fields(const FaultEvent& e, int digits = 9);
+
 /// A JSON array of strings from a comma-separated list of names ("a,b" -> ["a","b"]; "" -> []),
 /// the elements separated by `separator`.
 std::string json_string_array(const std::string& names, const char* separator = ",");
