@@ -17,6 +17,12 @@ void require(bool ok, const char* field, double value, const char* what) {
   }
 }
 
+/// Finite and within the plausible limit.
+bool within(double x, double lim) { return std::isfinite(x) && std::abs(x) <= lim; }
+
+/// Slack of the time comparisons (hold, enter and leave times) [s].
+constexpr double kEpsT = 1e-9;
+
 int sensor_index(Sensor s) { return static_cast<int>(s); }
 Sensor channel_sensor(int ch) { return ch == kV ? Sensor::kAccelerometer : Sensor::kGyro; }
 
@@ -674,26 +680,44 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
 
 void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection>* out) {
   if (!act_.v.ready() || !act_.g.ready()) return;
-  const auto usable = [&](double x, double lim) { return std::isfinite(x) && std::abs(x) <= lim; };
-  const bool v_ok = usable(s.v, p_.max_abs_v);
-  const bool r_ok = usable(s.r, p_.max_abs_r);
+  const bool v_ok = within(s.v, p_.max_abs_v);
+  const bool r_ok = within(s.r, p_.max_abs_r);
+  if (have_prev_ && dt > 0) propagate_observers(s, dt, v_ok, r_ok);
+  resync_observers(s, v_ok, r_ok);
+  const bool learn_ok = healthy_for_learning(s.t, v_ok, r_ok);
+  Statistics x;
+  if (!evaluate_banks(s, dt, learn_ok, v_ok, r_ok, &x)) return;
+  record_statistics(s.t, x, learn_ok);
+  update_monitors(s, dt, v_ok, r_ok);
+  update_confidences();
+  if (!act_.learned) return;
+  check_spikes(s.t, x.sw, out);
+  const Levels lv = levels(s.t, dt);
+  const Candidate c = choose_candidate(s.t, lv);
+  confirm_candidate(s.t, lv, c, out);
+  refine_kinds(s.t, out);
+  hold_or_clear(s.t, lv, c.k, out);
+}
+
+void Isolator::propagate_observers(const Sample& s, double dt, bool v_ok, bool r_ok) {
   // Propagate the observers over [t_{k-1}, t_k]: the rudder linear between its samples, the
   // driving measurements those of t_{k-1}.
-  if (have_prev_ && dt > 0) {
-    propagate(&act_, s, dt, v_ok, r_ok);
-    if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok);
-    const double dp = std::isfinite(prev_.delta) && std::abs(prev_.delta) <= p_.max_abs_delta
-                          ? prev_.delta
-                      : std::isfinite(last_delta_) ? last_delta_
-                                                   : 0.0;
-    const double dn = usable(s.delta, p_.max_abs_delta) ? s.delta : dp;
-    for (int c = 0; c < 2; ++c) {
-      if (!mon_on_[c]) continue;
-      const double y = c == kV ? prev_.v : prev_.r;
-      mon_[c].step(st_.speed_ratio * dt, in_obs_ * dp, in_obs_ * dn, y,
-                   usable(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
-    }
+  propagate(&act_, s, dt, v_ok, r_ok);
+  if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok);
+  const double dp = std::isfinite(prev_.delta) && std::abs(prev_.delta) <= p_.max_abs_delta
+                        ? prev_.delta
+                    : std::isfinite(last_delta_) ? last_delta_
+                                                 : 0.0;
+  const double dn = within(s.delta, p_.max_abs_delta) ? s.delta : dp;
+  for (int c = 0; c < 2; ++c) {
+    if (!mon_on_[c]) continue;
+    const double y = c == kV ? prev_.v : prev_.r;
+    mon_[c].step(st_.speed_ratio * dt, in_obs_ * dp, in_obs_ * dn, y,
+                 within(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
   }
+}
+
+void Isolator::resync_observers(const Sample& s, bool v_ok, bool r_ok) {
   // A sensor whose fault cleared drives its dedicated observer again. While it was faulty
   // that observer followed the other observer's estimate of the channel, whose error is the
   // cross residual's (several times the structured one's): restart it from the measurement
@@ -718,19 +742,24 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     resync_[c] = false;
     resettle_until_[c] = s.t + settle_time_;
   }
+}
+
+bool Isolator::healthy_for_learning(double t, bool v_ok, bool r_ok) const {
   // Healthy data for learning: both channels usable, and no fault condition raised now or
   // within resume_after_fault (a fault that hides with the signal clears and re-raises).
   bool faulty = false;
   for (const Condition& c : cond_) faulty = faulty || c.active;
   // Nor while identification finds the data inconsistent with the vessel's dynamics (a
   // fault no residual sees yet, e.g. one that began while the first design was learning).
-  const bool learn_ok = v_ok && r_ok && !faulty && !data_inconsistent_ && !st_.model_mismatch &&
-                        s.t - t_last_fault_ >= p_.resume_after_fault;
-  double raw[4];
-  Vec2 sw;
+  return v_ok && r_ok && !faulty && !data_inconsistent_ && !st_.model_mismatch &&
+         t - t_last_fault_ >= p_.resume_after_fault;
+}
+
+bool Isolator::evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
+                              Statistics* x) {
   bool swapped = false;
   if (has_shadow_ && dt > 0 && st_.input.delta_ok) {
-    evaluate(&shadow_, s, dt, learn_ok, v_ok, r_ok, raw, &sw);
+    evaluate(&shadow_, s, dt, learn_ok, v_ok, r_ok, x->raw, &x->sw);
     if (shadow_.learned) {
       swapped = true;  // this sample is already in its windows
       // The redesign has learned its own statistics: it takes over.
@@ -745,35 +774,42 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     }
   }
   st_.settling = s.t < act_.settle_until;
-  if (st_.settling || !(dt > 0) || !st_.input.delta_ok) return;
+  if (st_.settling || !(dt > 0) || !st_.input.delta_ok) return false;
 
-  if (!swapped) evaluate(&act_, s, dt, learn_ok, v_ok, r_ok, raw, &sw);
+  if (!swapped) evaluate(&act_, s, dt, learn_ok, v_ok, r_ok, x->raw, &x->sw);
   st_.learning = !act_.learned;
-  if (!act_.scales_learned) return;
+  if (!act_.scales_learned) return false;
   publish_bank();
+  return true;
+}
+
+void Isolator::record_statistics(double t, const Statistics& x, bool learn_ok) {
   for (int c = 0; c < 2; ++c) {
-    if (!std::isfinite(sw(c))) continue;
-    hist_s_[c].emplace_back(s.t, sw(c));
-    hist_d_[c].emplace_back(s.t, raw[2 + c]);
-    hist_x_[c].emplace_back(s.t, c == kV ? act_.g.x()(0) : act_.v.x()(1));
-    prune(&hist_s_[c], s.t - p_.classify_window);
-    prune(&hist_d_[c], s.t - p_.classify_window);
-    prune(&hist_x_[c], s.t - p_.classify_window);
+    if (!std::isfinite(x.sw(c))) continue;
+    hist_s_[c].emplace_back(t, x.sw(c));
+    hist_d_[c].emplace_back(t, x.raw[2 + c]);
+    hist_x_[c].emplace_back(t, c == kV ? act_.g.x()(0) : act_.v.x()(1));
+    prune(&hist_s_[c], t - p_.classify_window);
+    prune(&hist_d_[c], t - p_.classify_window);
+    prune(&hist_x_[c], t - p_.classify_window);
   }
   st_.J = act_.J;
   st_.D = act_.D;
   if (act_.learned) {
     // Healthy maxima, learned from samples older than a raise could be late.
     pending_stats_.push_back(
-        PendingStat{s.t, {act_.J(0), act_.J(1), act_.D(0), act_.D(1)}, learn_ok});
-    while (!pending_stats_.empty() && s.t - pending_stats_.front().t > history_lag()) {
+        PendingStat{t, {act_.J(0), act_.J(1), act_.D(0), act_.D(1)}, learn_ok});
+    while (!pending_stats_.empty() && t - pending_stats_.front().t > history_lag()) {
       if (pending_stats_.front().ok)
         healthy_.add(pending_stats_.front().t, pending_stats_.front().x);
       pending_stats_.pop_front();
     }
   }
-  st_.s = Vec2(raw[0], raw[1]);
-  st_.d = Vec2(raw[2], raw[3]);
+  st_.s = Vec2(x.raw[0], x.raw[1]);
+  st_.d = Vec2(x.raw[2], x.raw[3]);
+}
+
+void Isolator::update_monitors(const Sample& s, double dt, bool v_ok, bool r_ok) {
   // Monitors of raised channels: whitened like the structured residual they continue.
   for (int c = 0; c < 2; ++c) {
     const double y = c == kV ? s.v : s.r;
@@ -791,12 +827,17 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
                : kind == FaultKind::kNoise || kind == FaultKind::kSpikes ? win_m_[c].mean()
                                                                          : 1.0 + m * m;
   }
+}
+
+void Isolator::update_confidences() {
+  // C_i = |l_i^T e| / (|l_i| |e|) on the excess of each channel's statistic over its mean.
   const Vec2 e(std::sqrt(std::max(0.0, st_.J(0) - 1.0)), std::sqrt(std::max(0.0, st_.J(1) - 1.0)));
   const double en = e.norm();
   st_.c_a = en > 0 ? e(0) / en : 0.0;
   st_.c_g = en > 0 ? e(1) / en : 0.0;
-  if (!act_.learned) return;
+}
 
+void Isolator::check_spikes(double t, const Vec2& sw, std::vector<Detection>* out) {
   // Spikes: runs of one or two outliers.
   for (int c = 0; c < 2; ++c) {
     if (!std::isfinite(sw(c))) continue;
@@ -805,7 +846,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     const double a = std::abs(sw(c));
     if (a > p_.spike_gate) {
       if (ch.outlier_run++ == 0) {
-        ch.outlier_start = s.t;
+        ch.outlier_start = t;
         ch.run_isolated = ch.last_ordinary;
       }
     } else {
@@ -816,12 +857,12 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
       ch.outlier_run = 0;
     }
     ch.last_ordinary = a < 0.5 * p_.spike_gate;
-    prune(&ch.spikes, s.t - p_.spike_window);
+    prune(&ch.spikes, t - p_.spike_window);
     const int count = static_cast<int>(ch.spikes.size());
     const bool on = count >= p_.spike_count;
     const bool was = cond_[c].sources & kSpikes;
     if (on != was && (on || count == 0)) {
-      set_condition(channel_sensor(c), kSpikes, on, FaultKind::kSpikes, s.t,
+      set_condition(channel_sensor(c), kSpikes, on, FaultKind::kSpikes, t,
                     std::string(c == kV ? "accelerometer" : "gyro") +
                         (on ? ": " + std::to_string(count) + " spikes in " +
                                   std::to_string(p_.spike_window) + " s"
@@ -829,111 +870,12 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
                     out);
     }
   }
+}
 
-  // Residual evaluation with hysteresis, each channel against its own thresholds.
-  const Vec2 thr = st_.thresholds;
-  const std::size_t n_full = window_samples(dt);
-  Vec2 ratio = st_.J.cwiseQuotient(thr);  // > 1: above the enter threshold
-  for (int c = 0; c < 2; ++c) {
-    // refilling or settling after a fault cleared
-    if (act_.win_s[c].v.size() < n_full || s.t < resettle_until_[c]) ratio(c) = 0.0;
-  }
-  const Vec2 thr_exit_d = p_.exit_ratio * st_.thresholds_d;
-  const double eps_t = 1e-9;
-  const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual,
-             u_res = cond_[2].sources & kResidual;
-  // Candidate raise: 0 accelerometer, 1 gyro, 2 model mismatch (not a sensor).
-  int candidate = -1;
-  int reclassify = -1;  ///< a raised sensor whose evidence turned out to be the model's
-  if (st_.model_mismatch) {
-    // Detection resumes once the model holds again: every statistic below its leave
-    // threshold for leave_time (and the verdict at least min_active_time old).
-    const bool quiet = (st_.J.array() <= p_.exit_ratio * thr.array()).all() &&
-                       (st_.D.array() <= thr_exit_d.array()).all();
-    if (!quiet) {
-      below_mm_since_ = kNaN;
-    } else {
-      if (std::isnan(below_mm_since_)) below_mm_since_ = s.t;
-      if (s.t - below_mm_since_ + eps_t >= p_.leave_time &&
-          s.t - mismatch_since_ + eps_t >= p_.min_active_time) {
-        st_.model_mismatch = false;
-        st_.mismatch_reason.clear();
-        below_mm_since_ = kNaN;
-      }
-    }
-  } else if (!a_res && !g_res && !u_res) {
-    if (ratio.maxCoeff() > 1.0) {
-      if (st_.c_a >= p_.c_min && st_.c_a - st_.c_g >= p_.c_margin) {
-        candidate = 0;
-      } else if (st_.c_g >= p_.c_min && st_.c_g - st_.c_a >= p_.c_margin) {
-        candidate = 1;
-      } else {
-        candidate = 2;  // both channels at once: the evidence singles out no sensor
-      }
-    }
-  } else if (!u_res && a_res != g_res) {
-    // One sensor raised: the other channel's structured residual is blind to its fault, so
-    // a single sensor fault never lights it. Soon after the raise, it rising too says the
-    // model, not the raised sensor, is wrong (the raise is withdrawn); later it is a second
-    // fault, on its own channel.
-    const int raised = a_res ? 0 : 1, other = 1 - raised;
-    if (ratio(other) > 1.0) {
-      if (s.t - raised_at_[raised] <= p_.mismatch_window) {
-        candidate = 2;
-        reclassify = raised;
-      } else {
-        candidate = other;
-      }
-    }
-  }
-  const double enter = (a_res || g_res) && candidate != 2
-                           ? std::max(p_.enter_time, p_.second_fault_time)
-                           : p_.enter_time;
-  for (int k = 0; k < 3; ++k) {
-    if (k != candidate) {
-      above_since_[k] = kNaN;
-      continue;
-    }
-    if (std::isnan(above_since_[k])) above_since_[k] = s.t;
-    if (s.t - above_since_[k] + eps_t < enter) continue;
-    above_since_[k] = kNaN;
-    if (k == 2) {
-      // Model mismatch: a status with its reason, counted; never a latched sensor fault.
-      char buf[160];
-      std::snprintf(buf, sizeof buf,
-                    "residuals of both channels (J_N %.3g / %.3g against %.3g / %.3g)%s", st_.J(0),
-                    st_.J(1), thr(0), thr(1),
-                    reclassify >= 0
-                        ? reclassify == 0 ? " after an accelerometer raise" : " after a gyro raise"
-                        : "");
-      st_.model_mismatch = true;
-      pending_stats_.clear();
-      st_.mismatch_reason = buf;
-      ++st_.mismatches;
-      mismatch_since_ = s.t;
-      below_mm_since_ = kNaN;
-      if (reclassify >= 0) {
-        refine_at_[reclassify] = kNaN;
-        set_condition(static_cast<Sensor>(reclassify), kResidual, false, cond_[reclassify].kind,
-                      s.t, std::string("withdrawn: model mismatch, not a sensor fault: ") + buf,
-                      out);
-        below_since_[reclassify] = kNaN;
-      }
-      continue;
-    }
-    const Sensor sensor = static_cast<Sensor>(k);
-    const FaultKind kind = classify(k);
-    refine_at_[k] = s.t + 0.5 * p_.classify_window;
-    const std::string msg = std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
-                            " channel: J_N " + std::to_string(st_.J(k)) + " > " +
-                            std::to_string(thr(k));
-    set_condition(sensor, kResidual, true, kind, s.t, msg, out);
-    raised_at_[k] = s.t;
-    below_since_[k] = kNaN;
-  }
+void Isolator::refine_kinds(double t, std::vector<Detection>* out) {
   // Refine the kind once more data after the raise shows the fault's shape.
   for (int k = 0; k < 2; ++k) {
-    if (std::isnan(refine_at_[k]) || s.t < refine_at_[k]) continue;
+    if (std::isnan(refine_at_[k]) || t < refine_at_[k]) continue;
     refine_at_[k] = kNaN;
     Condition& c = cond_[k];
     if (!(c.sources & kResidual)) continue;
@@ -944,38 +886,151 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
     // noise increase can look offset over the raise's few samples).
     const FaultKind refined = noise_like(k, raised_at_[k]) ? FaultKind::kNoise : classify_shape(k);
     if (refined == c.kind) continue;
-    Detection d = make_detection(static_cast<Sensor>(k), true, refined, s.t);
+    Detection d = make_detection(static_cast<Sensor>(k), true, refined, t);
     d.update = true;
     d.message = std::string("kind refined from ") + to_string(c.kind) + " to " + to_string(refined);
     c.kind = refined;
     out->push_back(d);
   }
+}
+
+Isolator::Levels Isolator::levels(double t, double dt) const {
+  // Residual evaluation with hysteresis, each channel against its own thresholds.
+  Levels lv;
+  lv.thr = st_.thresholds;
+  lv.n_full = window_samples(dt);
+  lv.ratio = st_.J.cwiseQuotient(lv.thr);  // > 1: above the enter threshold
+  for (int c = 0; c < 2; ++c) {
+    // refilling or settling after a fault cleared
+    if (act_.win_s[c].v.size() < lv.n_full || t < resettle_until_[c]) lv.ratio(c) = 0.0;
+  }
+  lv.thr_exit_d = p_.exit_ratio * st_.thresholds_d;
+  return lv;
+}
+
+Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
+  const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual,
+             u_res = cond_[2].sources & kResidual;
+  Candidate c;
+  if (st_.model_mismatch) {
+    // Detection resumes once the model holds again: every statistic below its leave
+    // threshold for leave_time (and the verdict at least min_active_time old).
+    const bool quiet = (st_.J.array() <= p_.exit_ratio * lv.thr.array()).all() &&
+                       (st_.D.array() <= lv.thr_exit_d.array()).all();
+    if (!quiet) {
+      below_mm_since_ = kNaN;
+    } else {
+      if (std::isnan(below_mm_since_)) below_mm_since_ = t;
+      if (t - below_mm_since_ + kEpsT >= p_.leave_time &&
+          t - mismatch_since_ + kEpsT >= p_.min_active_time) {
+        st_.model_mismatch = false;
+        st_.mismatch_reason.clear();
+        below_mm_since_ = kNaN;
+      }
+    }
+  } else if (!a_res && !g_res && !u_res) {
+    if (lv.ratio.maxCoeff() > 1.0) {
+      if (st_.c_a >= p_.c_min && st_.c_a - st_.c_g >= p_.c_margin) {
+        c.k = 0;
+      } else if (st_.c_g >= p_.c_min && st_.c_g - st_.c_a >= p_.c_margin) {
+        c.k = 1;
+      } else {
+        c.k = 2;  // both channels at once: the evidence singles out no sensor
+      }
+    }
+  } else if (!u_res && a_res != g_res) {
+    // One sensor raised: the other channel's structured residual is blind to its fault, so
+    // a single sensor fault never lights it. Soon after the raise, it rising too says the
+    // model, not the raised sensor, is wrong (the raise is withdrawn); later it is a second
+    // fault, on its own channel.
+    const int raised = a_res ? 0 : 1, other = 1 - raised;
+    if (lv.ratio(other) > 1.0) {
+      if (t - raised_at_[raised] <= p_.mismatch_window) {
+        c.k = 2;
+        c.reclassify = raised;
+      } else {
+        c.k = other;
+      }
+    }
+  }
+  return c;
+}
+
+void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
+                                 std::vector<Detection>* out) {
+  const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual;
+  const double enter =
+      (a_res || g_res) && c.k != 2 ? std::max(p_.enter_time, p_.second_fault_time) : p_.enter_time;
+  for (int k = 0; k < 3; ++k) {
+    if (k != c.k) {
+      above_since_[k] = kNaN;
+      continue;
+    }
+    if (std::isnan(above_since_[k])) above_since_[k] = t;
+    if (t - above_since_[k] + kEpsT < enter) continue;
+    above_since_[k] = kNaN;
+    if (k == 2) {
+      // Model mismatch: a status with its reason, counted; never a latched sensor fault.
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "residuals of both channels (J_N %.3g / %.3g against %.3g / %.3g)%s", st_.J(0),
+                    st_.J(1), lv.thr(0), lv.thr(1),
+                    c.reclassify >= 0 ? c.reclassify == 0 ? " after an accelerometer raise"
+                                                          : " after a gyro raise"
+                                      : "");
+      st_.model_mismatch = true;
+      pending_stats_.clear();
+      st_.mismatch_reason = buf;
+      ++st_.mismatches;
+      mismatch_since_ = t;
+      below_mm_since_ = kNaN;
+      if (c.reclassify >= 0) {
+        refine_at_[c.reclassify] = kNaN;
+        set_condition(static_cast<Sensor>(c.reclassify), kResidual, false, cond_[c.reclassify].kind,
+                      t, std::string("withdrawn: model mismatch, not a sensor fault: ") + buf, out);
+        below_since_[c.reclassify] = kNaN;
+      }
+      continue;
+    }
+    const Sensor sensor = static_cast<Sensor>(k);
+    const FaultKind kind = classify(k);
+    refine_at_[k] = t + 0.5 * p_.classify_window;
+    const std::string msg = std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
+                            " channel: J_N " + std::to_string(st_.J(k)) + " > " +
+                            std::to_string(lv.thr(k));
+    set_condition(sensor, kResidual, true, kind, t, msg, out);
+    raised_at_[k] = t;
+    below_since_[k] = kNaN;
+  }
+}
+
+void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Detection>* out) {
   // Hold / clear. While sensor i is faulty its dedicated observer is reconfigured (driven by
   // the other observer), so its structured entry takes the cross residual's scale; the cross
   // residual d_i = y_i - x_i(observer blind to i) carries the fault without absorption.
   for (int k = 0; k < 3; ++k) {
-    if (!(cond_[k].sources & kResidual) || k == candidate) continue;
+    if (!(cond_[k].sources & kResidual) || k == c) continue;
     // The reconfigured observer's structured entry has about the cross residual's scale.
     const double rescale =
         k < 2 ? std::min(1.0, std::pow(st_.sigma_s(k) / st_.sigma_d(k), 2.0)) : 1.0;
     // In units of the leave threshold: below 1 the condition may clear.
-    double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) / thr_exit_d(k)
-                        : ratio.maxCoeff() / p_.exit_ratio;
+    double hold = k < 2 ? std::max(st_.D(k), rescale * st_.J(k)) / lv.thr_exit_d(k)
+                        : lv.ratio.maxCoeff() / p_.exit_ratio;
     if (k < 2) {
       // The monitor sees the fault with the structured residual's small noise: its offset
       // in the fault's direction (a fault that ended leaves an offset against it), or for
       // zero-mean faults its energy (their aftermath is as short as the observer's memory
       // of the noise). A scale error changes sign with the signal: the cross residual holds.
-      if (mon_on_[k] && mon_ok_[k] && win_m_[k].v.size() >= n_full) {
-        hold = std::max(hold, st_.M(k) / (p_.exit_ratio * thr(k)));
+      if (mon_on_[k] && mon_ok_[k] && win_m_[k].v.size() >= lv.n_full) {
+        hold = std::max(hold, st_.M(k) / (p_.exit_ratio * lv.thr(k)));
       }
     }
-    const double leave = k < 2 ? thr_exit_d(k) : p_.exit_ratio * thr.maxCoeff();
+    const double leave = k < 2 ? lv.thr_exit_d(k) : p_.exit_ratio * lv.thr.maxCoeff();
     if (hold < 1.0) {
-      if (std::isnan(below_since_[k])) below_since_[k] = s.t;
-      if (s.t - below_since_[k] + eps_t >= p_.leave_time &&
-          s.t - raised_at_[k] + eps_t >= p_.min_active_time) {
-        set_condition(static_cast<Sensor>(k), kResidual, false, cond_[k].kind, s.t,
+      if (std::isnan(below_since_[k])) below_since_[k] = t;
+      if (t - below_since_[k] + kEpsT >= p_.leave_time &&
+          t - raised_at_[k] + kEpsT >= p_.min_active_time) {
+        set_condition(static_cast<Sensor>(k), kResidual, false, cond_[k].kind, t,
                       "residual back below " + std::to_string(leave), out);
         below_since_[k] = kNaN;
       }

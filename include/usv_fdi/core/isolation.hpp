@@ -275,7 +275,44 @@ class Isolator {
   void jump_checks(const Sample& s, std::vector<Detection>* out);
   /// The observers are designed, settled and have learned their statistics.
   bool model_live() const;
+  /// The observers' residuals, one sample: a short sequence of the steps below.
   void residual_checks(const Sample& s, double dt, std::vector<Detection>* out);
+  /// A sample's raw statistics: structured s (0, 1) and cross d (2, 3) residuals, and the
+  /// whitened structured residual sw.
+  struct Statistics {
+    double raw[4] = {0.0, 0.0, 0.0, 0.0};
+    Vec2 sw = Vec2::Constant(kNaN);
+  };
+  /// The statistics against their thresholds.
+  struct Levels {
+    Vec2 thr = Vec2::Zero();         ///< enter thresholds on J_N
+    Vec2 ratio = Vec2::Zero();       ///< J_N / thr (0 while a window refills or resettles)
+    Vec2 thr_exit_d = Vec2::Zero();  ///< leave thresholds on D_N
+    std::size_t n_full = 0;          ///< samples in a full window
+  };
+  /// Candidate raise: 0 accelerometer, 1 gyro, 2 model mismatch (not a sensor), -1 none.
+  struct Candidate {
+    int k = -1;
+    int reclassify = -1;  ///< a raised sensor whose evidence turned out to be the model's
+  };
+  void propagate_observers(const Sample& s, double dt, bool v_ok, bool r_ok);
+  void resync_observers(const Sample& s, bool v_ok, bool r_ok);
+  bool healthy_for_learning(double t, bool v_ok, bool r_ok) const;
+  /// Evaluates the redesign (which takes over once it has learned) and the active bank;
+  /// false when nothing more is to be done on this sample (settling, no rudder, scales not
+  /// learned yet).
+  bool evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
+                      Statistics* x);
+  void record_statistics(double t, const Statistics& x, bool learn_ok);
+  void update_monitors(const Sample& s, double dt, bool v_ok, bool r_ok);
+  void update_confidences();
+  void check_spikes(double t, const Vec2& sw, std::vector<Detection>* out);
+  Levels levels(double t, double dt) const;
+  Candidate choose_candidate(double t, const Levels& lv);
+  void confirm_candidate(double t, const Levels& lv, const Candidate& c,
+                         std::vector<Detection>* out);
+  void refine_kinds(double t, std::vector<Detection>* out);
+  void hold_or_clear(double t, const Levels& lv, int candidate, std::vector<Detection>* out);
   FaultKind classify(int ch) const;
   FaultKind classify_shape(int ch) const;
   bool noise_like(int ch, double t_raise) const;
