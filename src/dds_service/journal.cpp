@@ -37,14 +37,6 @@ std::string hex64(std::uint64_t x) {
   return buf;
 }
 
-/// 17 significant digits: parses back to the same double. NaN/Inf: null.
-std::string number(double x) {
-  if (!std::isfinite(x)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
 struct Bad : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -141,7 +133,7 @@ std::string StateJournal::serialise(std::uint32_t mmsi, const std::vector<FaultE
   std::string s = "{\n  \"format\": \"" + std::string(kFormat) +
                   "\",\n  \"version\": " + std::to_string(kVersion) +
                   ",\n  \"mmsi\": " + std::to_string(mmsi) +
-                  ",\n  \"written\": " + number(written) + ",\n  \"instances\": [";
+                  ",\n  \"written\": " + io::json_number(written, 17) + ",\n  \"instances\": [";
   for (std::size_t i = 0; i < events.size(); ++i) {
     const FaultEvent& e = events[i];
     s += i == 0 ? "\n" : ",\n";
