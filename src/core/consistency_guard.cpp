@@ -129,9 +129,12 @@ void ConsistencyGuard::least_squares_with_pending(Mat2* Phi_ls, Mat2* Y_ls) cons
 }
 
 int ConsistencyGuard::accepted_windows() const {
-  int n = 0;
-  for (const GuardWindow& w : windows_) n += w.accepted;
-  return n;
+  if (accepted_gen_ != gen_) {
+    accepted_n_ = 0;
+    for (const GuardWindow& w : windows_) accepted_n_ += w.accepted;
+    accepted_gen_ = gen_;
+  }
+  return accepted_n_;
 }
 
 bool ConsistencyGuard::consistent() const {
@@ -178,6 +181,7 @@ bool ConsistencyGuard::close_segment(double t, bool converged, bool supervised, 
     w.t_end = t;
     windows_.push_back(w);
     if (static_cast<int>(windows_.size()) > kWindows) windows_.pop_front();
+    ++gen_;
     const std::size_t n = pending_.size();
     for (std::size_t k = n >= 2 ? n - 2 : 0; k < n; ++k) {
       ++pending_[k].votes;
@@ -208,6 +212,7 @@ bool ConsistencyGuard::close_segment(double t, bool converged, bool supervised, 
       for (GuardWindow& w : windows_) {
         if (w.seg0 == f.id || w.seg1 == f.id) w.accepted = false;
       }
+      ++gen_;
     } else {
       mem_.append(f.mem);
       clock_ += f.mem.len;
@@ -241,15 +246,26 @@ void ConsistencyGuard::update_noise(const Mat2& At) {
   // is chi-square with 2 degrees of freedom. The median (2 ln 2 of them) is robust to the
   // few windows a fault may have brought in; normalising by each window's own Z makes it
   // independent of the instruments' scale (a refreshed auxiliary model changes nothing).
+  // Each window's statistic is kept in chi2_ (NaN: not accepted, or Z singular) for rejudge.
+  // Nothing is computed again while neither the windows nor A^ have changed (the judgement
+  // of the next window usually follows a rejudgement that changed nothing).
+  if (noise_gen_ == gen_ && (At.array() == noise_At_.array()).all()) return;
+  noise_gen_ = gen_;
+  noise_At_ = At;
   noise_.setZero();
-  std::vector<double> q[2];
-  for (const GuardWindow& w : windows_) {
-    Vec2 x;
-    if (!w.accepted || !w.chi2(At, &x)) continue;
-    for (int i = 0; i < 2; ++i) q[i].push_back(x(i));
+  chi2_.resize(windows_.size());
+  for (int i = 0; i < 2; ++i) scratch_[i].clear();
+  for (std::size_t j = 0; j < windows_.size(); ++j) {
+    const GuardWindow& w = windows_[j];
+    Vec2& x = chi2_[j];
+    if (!w.accepted || !w.chi2(At, &x)) {
+      x = Vec2(kNaN, kNaN);
+      continue;
+    }
+    for (int i = 0; i < 2; ++i) scratch_[i].push_back(x(i));
   }
-  if (static_cast<int>(q[0].size()) < kMinBatches) return;
-  for (int i = 0; i < 2; ++i) noise_(i) = median_in_place(&q[i]) / (2.0 * M_LN2);
+  if (static_cast<int>(scratch_[0].size()) < kMinBatches) return;
+  for (int i = 0; i < 2; ++i) noise_(i) = median_in_place(&scratch_[i]) / (2.0 * M_LN2);
 }
 
 bool ConsistencyGuard::judge(const GuardWindow& w, Change* c) {
@@ -305,8 +321,8 @@ bool ConsistencyGuard::rejudge(Change* c) {
     int j_worst = -1;
     for (int j = 0; j < static_cast<int>(windows_.size()); ++j) {
       const GuardWindow& w = windows_[j];
-      Vec2 x;
-      if (!w.accepted || !in_memory(w.seg0) || !in_memory(w.seg1) || !w.chi2(At, &x)) continue;
+      const Vec2& x = chi2_[static_cast<std::size_t>(j)];  // update_noise's, under this At
+      if (std::isnan(x(0)) || !in_memory(w.seg0) || !in_memory(w.seg1)) continue;
       const double T = x(0) / noise_(0) + x(1) / noise_(1);
       if (T > worst) {
         worst = T;
@@ -324,6 +340,7 @@ bool ConsistencyGuard::rejudge(Change* c) {
     for (GuardWindow& v : windows_) {
       if (v.seg0 == s0 || v.seg1 == s0 || v.seg0 == s1 || v.seg1 == s1) v.accepted = false;
     }
+    ++gen_;
     ++report_.removed_windows;
     c->unsettled = true;
     removed = true;
@@ -402,6 +419,7 @@ bool ConsistencyGuard::check_memory(double t) {
     w.accepted = w.seg0 >= first && final_segment(w.seg0) && final_segment(w.seg1);
     w.clock = clock_;
   }
+  ++gen_;
   inconsistent_run_ = 0.0;
   ++report_.resets;
   return true;

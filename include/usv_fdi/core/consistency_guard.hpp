@@ -162,6 +162,13 @@ class ConsistencyGuard {
   double inconsistent_run_ = 0.0;    ///< rejected data since the last accepted segment [s]
   bool suspended_ = false;           ///< after recent_time past convergence
   Vec2 noise_ = Vec2::Zero();        ///< robust noise level s_i per row (0: not known)
+  std::vector<Vec2> chi2_;           ///< update_noise's statistic of each window (NaN: none)
+  std::vector<double> scratch_[2];   ///< update_noise's values of each row (kept: no allocation)
+  std::uint64_t gen_ = 0;  ///< counts the changes of windows_ (which, or which are accepted)
+  std::uint64_t noise_gen_ = ~std::uint64_t{0};  ///< gen_ when noise_ and chi2_ were computed
+  Mat2 noise_At_ = Mat2::Zero();                 ///< ... and under which A^T
+  mutable std::uint64_t accepted_gen_ = ~std::uint64_t{0};  ///< gen_ of accepted_n_
+  mutable int accepted_n_ = 0;                              ///< accepted windows
   GuardReport report_;
 };
 

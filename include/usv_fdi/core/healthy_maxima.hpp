@@ -17,7 +17,8 @@ class HealthyMaxima {
   /// block: length of a block [s]; history: how far back the maxima reach [s] (>= block).
   HealthyMaxima(double block, double history)
       : block_(block),
-        blocks_(static_cast<std::size_t>(std::max(1.0, std::ceil(history / block)))) {}
+        blocks_(static_cast<std::size_t>(std::max(1.0, std::ceil(history / block)))),
+        full_log_(std::log1p(this->history())) {}
 
   /// One healthy sample of the N statistics at time t.
   void add(double t, const double (&x)[N]) {
@@ -38,8 +39,12 @@ class HealthyMaxima {
   /// the time covered so far is scaled by ln(1 + history / tau) / ln(1 + covered / tau),
   /// tau = 1 s (about the decorrelation time of a windowed statistic).
   double extrapolated_max(int i) const {
-    const double full = std::log1p(history()), seen = std::log1p(std::max(covered_, 1.0));
-    return max(i) * full / seen;
+    // The logarithms are kept: the thresholds ask for them on every sample.
+    if (!(covered_ == seen_for_)) {
+      seen_for_ = covered_;
+      seen_log_ = std::log1p(std::max(covered_, 1.0));
+    }
+    return max(i) * full_log_ / seen_log_;
   }
   /// Healthy time the maxima cover [s] (at most the history).
   double covered() const { return covered_; }
@@ -73,6 +78,9 @@ class HealthyMaxima {
   double current_[N] = {};
   double done_[N] = {};
   bool seen_ = false;
+  double full_log_;                ///< ln(1 + history)
+  mutable double seen_for_ = NAN;  ///< the covered time seen_log_ is of
+  mutable double seen_log_ = 0.0;  ///< ln(1 + max(covered, 1))
 };
 
 }  // namespace usvfdi
