@@ -120,15 +120,25 @@ void IsolationParams::validate() const {
 }
 
 void Isolator::Window::push(double x, std::size_t n) {
-  v.push_back(x);
-  sum += x;
-  while (v.size() > n) {
-    sum -= v.front();
-    v.pop_front();
+  if (count_ == buf_.size()) {  // full: grow, oldest first
+    std::vector<double> grown(std::max<std::size_t>({2 * buf_.size(), n + 1, 16}));
+    for (std::size_t i = 0; i < count_; ++i) grown[i] = at(i);
+    buf_.swap(grown);
+    head_ = 0;
   }
-  if (v.size() == n && (n & 63) == 0) {  // bound round-off drift of the running sum
-    sum = 0;
-    for (double e : v) sum += e;
+  std::size_t tail = head_ + count_;
+  if (tail >= buf_.size()) tail -= buf_.size();
+  buf_[tail] = x;
+  ++count_;
+  sum_ += x;
+  while (count_ > n) {
+    sum_ -= buf_[head_];
+    if (++head_ == buf_.size()) head_ = 0;
+    --count_;
+  }
+  if (count_ == n && (n & 63) == 0) {  // bound round-off drift of the running sum
+    sum_ = 0;
+    for (std::size_t i = 0; i < count_; ++i) sum_ += at(i);
   }
 }
 
@@ -658,7 +668,7 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
   b->D = Vec2(b->win_d[0].mean(), b->win_d[1].mean());
 
   if (!b->learned) {
-    if (learn_ok && b->win_s[0].v.size() >= n && b->win_s[1].v.size() >= n) {
+    if (learn_ok && b->win_s[0].size() >= n && b->win_s[1].size() >= n) {
       for (int c = 0; c < 2; ++c) {
         b->learn_J[c].push_back(b->J(c));
         b->learn_D[c].push_back(b->D(c));
@@ -902,7 +912,7 @@ Isolator::Levels Isolator::levels(double t, double dt) const {
   lv.ratio = st_.J.cwiseQuotient(lv.thr);  // > 1: above the enter threshold
   for (int c = 0; c < 2; ++c) {
     // refilling or settling after a fault cleared
-    if (act_.win_s[c].v.size() < lv.n_full || t < resettle_until_[c]) lv.ratio(c) = 0.0;
+    if (act_.win_s[c].size() < lv.n_full || t < resettle_until_[c]) lv.ratio(c) = 0.0;
   }
   lv.thr_exit_d = p_.exit_ratio * st_.thresholds_d;
   return lv;
@@ -1021,7 +1031,7 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
       // in the fault's direction (a fault that ended leaves an offset against it), or for
       // zero-mean faults its energy (their aftermath is as short as the observer's memory
       // of the noise). A scale error changes sign with the signal: the cross residual holds.
-      if (mon_on_[k] && mon_ok_[k] && win_m_[k].v.size() >= lv.n_full) {
+      if (mon_on_[k] && mon_ok_[k] && win_m_[k].size() >= lv.n_full) {
         hold = std::max(hold, st_.M(k) / (p_.exit_ratio * lv.thr(k)));
       }
     }
@@ -1060,12 +1070,13 @@ FaultKind Isolator::classify(int ch) const {
   // 0. Stuck: the channel repeats its value exactly (a healthy, noisy sensor never does).
   if (ch_[ch].stuck_samples >= 2) return FaultKind::kStuck;
   // 1. Spikes: the excess energy of the window sits in one or two samples.
-  const auto& w = act_.win_sl[ch].v;
+  const Window& w = act_.win_sl[ch];
   if (w.empty()) return FaultKind::kUnknown;
   std::vector<double> sq;
   sq.reserve(w.size());
   double total = 0, sum = 0;
-  for (double x : w) {
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const double x = w.at(i);
     sq.push_back(x * x);
     total += x * x;
     sum += x;

@@ -197,11 +197,23 @@ class Isolator {
   const SpeedRatio& speed() const { return speed_; }
 
  private:
-  struct Window {
-    std::deque<double> v;
-    double sum = 0.0;
+  /// The last n values and their running sum, in a ring (no allocation once it has grown).
+  class Window {
+   public:
     void push(double x, std::size_t n);
-    double mean() const { return v.empty() ? 0.0 : sum / static_cast<double>(v.size()); }
+    std::size_t size() const { return count_; }
+    bool empty() const { return count_ == 0; }
+    double mean() const { return count_ == 0 ? 0.0 : sum_ / static_cast<double>(count_); }
+    /// The i-th value held, oldest first.
+    double at(std::size_t i) const {
+      const std::size_t k = head_ + i;
+      return buf_[k < buf_.size() ? k : k - buf_.size()];
+    }
+
+   private:
+    std::vector<double> buf_;
+    std::size_t head_ = 0, count_ = 0;
+    double sum_ = 0.0;
   };
   struct Condition {
     bool active = false;
