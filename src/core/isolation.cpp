@@ -272,7 +272,7 @@ Detection Isolator::make_detection(Sensor sensor, bool active, FaultKind kind, d
 
 void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind, double t,
                              const std::string& message, std::vector<Detection>* out) {
-  Condition& c = cond_[sensor_index(sensor)];
+  Condition& c = sens_[sensor_index(sensor)].cond;
   const unsigned before = c.sources;
   c.sources = on ? (c.sources | src) : (c.sources & ~src);
   if (before == 0 && c.sources != 0) {
@@ -289,8 +289,8 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
   } else if (before != 0 && c.sources == 0) {
     c.active = false;
     if (sensor != Sensor::kUnknown) {
-      resync_[sensor_index(sensor)] = true;
-      mon_on_[sensor_index(sensor)] = false;
+      chan_[sensor_index(sensor)].resync = true;
+      chan_[sensor_index(sensor)].mon_on = false;
     }
     Detection d = make_detection(sensor, false, c.kind, t);
     d.message = message;
@@ -304,7 +304,7 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
     d.message = std::string("kind refined from ") + to_string(c.kind) + " to " + to_string(kind) +
                 ": " + message;
     c.kind = kind;
-    if (sensor != Sensor::kUnknown) refine_at_[sensor_index(sensor)] = kNaN;
+    if (sensor != Sensor::kUnknown) chan_[sensor_index(sensor)].refine_at = kNaN;
     out->push_back(d);
   }
 }
@@ -312,20 +312,20 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
 void Isolator::start_monitor(int ch) {
   // The observer in force is not reconfigured yet (that starts with the next step): the
   // monitor continues it, driven by its own sensor.
-  mon_[ch] = ch == kV ? act_.v : act_.g;
-  mon_on_[ch] = mon_[ch].ready();
-  win_m_[ch] = Window{};
-  win_ms_[ch] = Window{};
-  mon_sign_[ch] = act_.win_sl[ch].mean() < 0 ? -1.0 : 1.0;
+  chan_[ch].mon = ch == kV ? act_.v : act_.g;
+  chan_[ch].mon_on = chan_[ch].mon.ready();
+  chan_[ch].win_m = Window{};
+  chan_[ch].win_ms = Window{};
+  chan_[ch].mon_sign = act_.win_sl[ch].mean() < 0 ? -1.0 : 1.0;
   // After a constant fault f ends, the monitor's residual is c Ad^k e_ss, e_ss = -(I -
   // Ad)^-1 L f its steady error: with g_k = c Ad^k (I - Ad)^-1 L >= 0 for all k (real
   // poles; checked here) that transient opposes the fault, so a residual in the fault's
   // direction is the fault itself, never its aftermath.
-  mon_ok_[ch] = false;
-  const Mat2 Ad = mon_[ch].Ad();
+  chan_[ch].mon_ok = false;
+  const Mat2 Ad = chan_[ch].mon.Ad();
   const Mat2 I_Ad = Mat2::Identity() - Ad;
-  if (mon_on_[ch] && std::abs(I_Ad.determinant()) > 1e-12 && mon_[ch].Gy().allFinite()) {
-    Vec2 e = I_Ad.partialPivLu().solve(mon_[ch].Gy());
+  if (chan_[ch].mon_on && std::abs(I_Ad.determinant()) > 1e-12 && chan_[ch].mon.Gy().allFinite()) {
+    Vec2 e = I_Ad.partialPivLu().solve(chan_[ch].mon.Gy());
     const double e0 = e.norm();
     double lo = 0.0, hi = 0.0;
     for (int k = 0; k < 100000 && e.norm() > 1e-9 * e0; ++k) {
@@ -333,7 +333,7 @@ void Isolator::start_monitor(int ch) {
       hi = std::max(hi, e(ch));
       e = Ad * e;
     }
-    mon_ok_[ch] = e0 > 0 && lo >= -1e-3 * hi;
+    chan_[ch].mon_ok = e0 > 0 && lo >= -1e-3 * hi;
   }
 }
 
@@ -364,7 +364,7 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   bool suspect = !st_.input.v_ok || !st_.input.r_ok || !st_.input.delta_ok || !std::isfinite(s.v) ||
                  !std::isfinite(s.r) || !std::isfinite(s.delta);
   bool faulty = false;
-  for (const Condition& c : cond_) faulty = faulty || c.active;
+  for (const SensorState& x : sens_) faulty = faulty || x.cond.active;
   suspect = suspect || faulty;
   if (faulty) t_last_fault_ = s.t;
   if (st_.armed && !st_.learning && !st_.settling) {
@@ -422,7 +422,7 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
       }
       // How often this channel repeats a value while it moves (its quantisation), learned
       // while it is not taken for stuck.
-      if (!(c < 2 && (cond_[c].sources & kStuck)) && std::isfinite(ch.last_value)) {
+      if (!(c < 2 && (sens_[c].cond.sources & kStuck)) && std::isfinite(ch.last_value)) {
         // The mean of the first samples, then an exponential average over stuck_learn_time.
         ch.repeat_seen += 1.0;
         const double w = std::max(1.0 / ch.repeat_seen,
@@ -446,7 +446,7 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
     if (c == 2) continue;  // the rudder is not an INS sensor: it pauses FDI (status flag)
     const Sensor sensor = channel_sensor(c);
     const char* name = c == kV ? "accelerometer channel v" : "gyro channel r";
-    const bool was_stale = cond_[c].sources & kStale;
+    const bool was_stale = sens_[c].cond.sources & kStale;
     if (stale != was_stale) {
       set_condition(sensor, kStale, stale, FaultKind::kStale, s.t,
                     std::string(name) + (stale ? ": no valid value for " +
@@ -454,14 +454,14 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
                                                : ": valid values again"),
                     out);
     }
-    const bool was_stuck = cond_[c].sources & kStuck;
+    const bool was_stuck = sens_[c].cond.sources & kStuck;
     if (stuck != was_stuck) {
       set_condition(sensor, kStuck, stuck, FaultKind::kStuck, s.t,
                     std::string(name) + (stuck ? ": output frozen at " + std::to_string(x)
                                                : ": output moves again"),
                     out);
     }
-    const bool was_invalid = cond_[c].sources & kInvalid;
+    const bool was_invalid = sens_[c].cond.sources & kInvalid;
     if (invalid != was_invalid) {
       set_condition(sensor, kInvalid, invalid, FaultKind::kInvalid, s.t,
                     std::string(name) + (invalid ? ": repeated non-finite or absurd values"
@@ -469,13 +469,13 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
                     out);
     }
   }
-  st_.input.v_ok = ok[0] && !(cond_[0].sources & kStuck);
-  st_.input.r_ok = ok[1] && !(cond_[1].sources & kStuck);
+  st_.input.v_ok = ok[0] && !(sens_[0].cond.sources & kStuck);
+  st_.input.r_ok = ok[1] && !(sens_[1].cond.sources & kStuck);
   st_.input.delta_ok = ok[2];
   if (std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta) last_delta_ = s.delta;
   // Timing errors age out of the unknown channel too.
   prune(&timing_errors_, s.t - p_.spike_window);
-  if ((cond_[2].sources & kInvalid) && timing_errors_.empty()) {
+  if ((sens_[2].cond.sources & kInvalid) && timing_errors_.empty()) {
     set_condition(Sensor::kUnknown, kInvalid, false, FaultKind::kInvalid, s.t,
                   "sample timestamps increase again", out);
   }
@@ -496,7 +496,7 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
         std::isfinite(values[c]) && std::abs(values[c]) <= limits[c] ? values[c] : kNaN;
     // Learns from a channel no condition is raised on, with the rudder known.
     const bool learn_ok =
-        !cond_[c].active && st_.input.delta_ok && (c == kV ? st_.input.v_ok : st_.input.r_ok);
+        !sens_[c].cond.active && st_.input.delta_ok && (c == kV ? st_.input.v_ok : st_.input.r_ok);
     verdict[c] = jump_[c].update(s.t, y, delta, learn_ok);
     st_.jump_T(c) = jump_[c].statistic();
     st_.jump_threshold(c) = jump_[c].threshold();
@@ -521,15 +521,16 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
       d.c_a = ec(0) / ec.norm();
       d.c_g = ec(1) / ec.norm();
     };
-    if (v.step == JumpVerdict::Change::kRaise) jump_at_[c] = s.t;
-    if (v.noise == JumpVerdict::Change::kRaise && cond_[c].active &&
-        cond_[c].kind == FaultKind::kBias && s.t - jump_at_[c] <= 2.0 * p_.jump.noise_window) {
+    if (v.step == JumpVerdict::Change::kRaise) chan_[c].jump_at = s.t;
+    if (v.noise == JumpVerdict::Change::kRaise && sens_[c].cond.active &&
+        sens_[c].cond.kind == FaultKind::kBias &&
+        s.t - chan_[c].jump_at <= 2.0 * p_.jump.noise_window) {
       // The jump raised just before was the first samples of a noise rise: one condition,
       // its kind refined.
       set_condition(sensor, kNoiseRise, true, FaultKind::kNoise, s.t, name + v.message, out);
       set_condition(sensor, kJump, false, FaultKind::kBias, s.t, name + v.message, out);
       jump_[c].release();
-      Condition& cd = cond_[c];
+      Condition& cd = sens_[c].cond;
       if (cd.active && cd.kind != FaultKind::kNoise) {
         Detection d = make_detection(sensor, true, FaultKind::kNoise, s.t);
         d.update = true;
@@ -548,16 +549,17 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
     }
     // Once the observers are live they hold a jump like any residual fault (their cross
     // residual sees whether the offset is still there, or has gone without a jump back).
-    if ((cond_[c].sources & kJump) && model_live()) {
-      const bool held = cond_[c].sources & kResidual;  // the observers hold it already
+    if ((sens_[c].cond.sources & kJump) && model_live()) {
+      const bool held = sens_[c].cond.sources & kResidual;  // the observers hold it already
       set_condition(sensor, kResidual, true, FaultKind::kBias, s.t,
                     std::string(name) + "held by the observers", out);
       set_condition(sensor, kJump, false, FaultKind::kBias, s.t, "", out);
       if (!held) {
-        raised_at_[c] = s.t;
-        below_since_[c] = kNaN;
+        sens_[c].raised_at = s.t;
+        sens_[c].below_since = kNaN;
         // Its kind is refined from the residuals' shape like any other (a scale error jumps).
-        if (cond_[c].kind == FaultKind::kBias) refine_at_[c] = s.t + 0.5 * p_.classify_window;
+        if (sens_[c].cond.kind == FaultKind::kBias)
+          chan_[c].refine_at = s.t + 0.5 * p_.classify_window;
       }
       jump_[c].release();
     }
@@ -569,7 +571,7 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
     }
     // A jump the check no longer holds (withdrawn as the first samples of a noise rise) is
     // no source of this condition either.
-    if ((cond_[c].sources & kJump) && !jump_[c].jump_raised()) {
+    if ((sens_[c].cond.sources & kJump) && !jump_[c].jump_raised()) {
       set_condition(sensor, kJump, false, FaultKind::kBias, s.t,
                     std::string(name) + "jump withdrawn", out);
     }
@@ -581,7 +583,7 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
   if (dt > p_.stale_timeout) {
     // A gap: restart the observers from the measurements and let them settle again (the
     // monitors stop: the cross residual alone holds a raised fault after a gap).
-    mon_on_ = {false, false};
+    for (ChannelState& c : chan_) c.mon_on = false;
     const Vec2 y0(v_ok ? s.v : b->v.x()(0), r_ok ? s.r : b->g.x()(1));
     b->v.reset(y0);
     b->g.reset(y0);
@@ -603,7 +605,7 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
   // While a sensor is faulty, its dedicated observer is driven by the other observer's
   // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
   // the fault stays fully visible and the residual is clean the moment the fault ends.
-  const bool fa = cond_[0].active, fg = cond_[1].active;
+  const bool fa = sens_[0].cond.active, fg = sens_[1].cond.active;
   const bool pv = usable(prev_.v, p_.max_abs_v) && !fa;
   const bool pr = usable(prev_.r, p_.max_abs_r) && !fg;
   const double yv = pv ? prev_.v : b->g.x()(0);
@@ -720,10 +722,10 @@ void Isolator::propagate_observers(const Sample& s, double dt, bool v_ok, bool r
                                                  : 0.0;
   const double dn = within(s.delta, p_.max_abs_delta) ? s.delta : dp;
   for (int c = 0; c < 2; ++c) {
-    if (!mon_on_[c]) continue;
+    if (!chan_[c].mon_on) continue;
     const double y = c == kV ? prev_.v : prev_.r;
-    mon_[c].step(st_.speed_ratio * dt, in_obs_ * dp, in_obs_ * dn, y,
-                 within(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
+    chan_[c].mon.step(st_.speed_ratio * dt, in_obs_ * dp, in_obs_ * dn, y,
+                      within(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
   }
 }
 
@@ -738,7 +740,7 @@ void Isolator::resync_observers(const Sample& s, bool v_ok, bool r_ok) {
   // the channel may raise again once it has settled (settle_time) and its window is full.
   for (int c = 0; c < 2; ++c) {
     const double y = c == kV ? s.v : s.r;
-    if (!resync_[c] || !(c == kV ? v_ok : r_ok)) continue;
+    if (!chan_[c].resync || !(c == kV ? v_ok : r_ok)) continue;
     for (Bank* b : {&act_, &shadow_}) {
       // The other channel's state from the healthy observer (the reconfigured one inferred
       // it from the cross estimate, through the coupling a2 or a3), this one measured.
@@ -749,8 +751,8 @@ void Isolator::resync_observers(const Sample& s, bool v_ok, bool r_ok) {
       o.reset(x);
       for (auto* w : {&b->win_s[c], &b->win_sl[c], &b->win_d[c]}) *w = Window{};
     }
-    resync_[c] = false;
-    resettle_until_[c] = s.t + settle_time_;
+    chan_[c].resync = false;
+    chan_[c].resettle_until = s.t + settle_time_;
   }
 }
 
@@ -758,7 +760,7 @@ bool Isolator::healthy_for_learning(double t, bool v_ok, bool r_ok) const {
   // Healthy data for learning: both channels usable, and no fault condition raised now or
   // within resume_after_fault (a fault that hides with the signal clears and re-raises).
   bool faulty = false;
-  for (const Condition& c : cond_) faulty = faulty || c.active;
+  for (const SensorState& x : sens_) faulty = faulty || x.cond.active;
   // Nor while identification finds the data inconsistent with the vessel's dynamics (a
   // fault no residual sees yet, e.g. one that began while the first design was learning).
   return v_ok && r_ok && !faulty && !data_inconsistent_ && !st_.model_mismatch &&
@@ -796,12 +798,12 @@ bool Isolator::evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_
 void Isolator::record_statistics(double t, const Statistics& x, bool learn_ok) {
   for (int c = 0; c < 2; ++c) {
     if (!std::isfinite(x.sw(c))) continue;
-    hist_s_[c].emplace_back(t, x.sw(c));
-    hist_d_[c].emplace_back(t, x.raw[2 + c]);
-    hist_x_[c].emplace_back(t, c == kV ? act_.g.x()(0) : act_.v.x()(1));
-    prune(&hist_s_[c], t - p_.classify_window);
-    prune(&hist_d_[c], t - p_.classify_window);
-    prune(&hist_x_[c], t - p_.classify_window);
+    chan_[c].hist_s.emplace_back(t, x.sw(c));
+    chan_[c].hist_d.emplace_back(t, x.raw[2 + c]);
+    chan_[c].hist_x.emplace_back(t, c == kV ? act_.g.x()(0) : act_.v.x()(1));
+    prune(&chan_[c].hist_s, t - p_.classify_window);
+    prune(&chan_[c].hist_d, t - p_.classify_window);
+    prune(&chan_[c].hist_x, t - p_.classify_window);
   }
   st_.J = act_.J;
   st_.D = act_.D;
@@ -823,18 +825,18 @@ void Isolator::update_monitors(const Sample& s, double dt, bool v_ok, bool r_ok)
   // Monitors of raised channels: whitened like the structured residual they continue.
   for (int c = 0; c < 2; ++c) {
     const double y = c == kV ? s.v : s.r;
-    if (!mon_on_[c] || !(c == kV ? v_ok : r_ok)) continue;
-    const double w = (y - mon_[c].x()(c)) / act_.sigma_s(c);
-    win_m_[c].push(std::min(w * w, p_.clip * p_.clip), window_samples(dt));
-    win_ms_[c].push(std::max(-p_.clip, std::min(w, p_.clip)), window_samples(dt));
-    const FaultKind kind = cond_[c].kind;
-    const double m = std::max(0.0, mon_sign_[c] * win_ms_[c].mean());
+    if (!chan_[c].mon_on || !(c == kV ? v_ok : r_ok)) continue;
+    const double w = (y - chan_[c].mon.x()(c)) / act_.sigma_s(c);
+    chan_[c].win_m.push(std::min(w * w, p_.clip * p_.clip), window_samples(dt));
+    chan_[c].win_ms.push(std::max(-p_.clip, std::min(w, p_.clip)), window_samples(dt));
+    const FaultKind kind = sens_[c].cond.kind;
+    const double m = std::max(0.0, chan_[c].mon_sign * chan_[c].win_ms.mean());
     // Scale errors change sign with the signal; stuck, stale and invalid channels are
     // held by their sensor-level checks, which see exactly when they end.
     const bool none = kind == FaultKind::kScale || kind == FaultKind::kStuck ||
                       kind == FaultKind::kStale || kind == FaultKind::kInvalid;
     st_.M(c) = none                                                      ? 0.0
-               : kind == FaultKind::kNoise || kind == FaultKind::kSpikes ? win_m_[c].mean()
+               : kind == FaultKind::kNoise || kind == FaultKind::kSpikes ? chan_[c].win_m.mean()
                                                                          : 1.0 + m * m;
   }
 }
@@ -870,7 +872,7 @@ void Isolator::check_spikes(double t, const Vec2& sw, std::vector<Detection>* ou
     prune(&ch.spikes, t - p_.spike_window);
     const int count = static_cast<int>(ch.spikes.size());
     const bool on = count >= p_.spike_count;
-    const bool was = cond_[c].sources & kSpikes;
+    const bool was = sens_[c].cond.sources & kSpikes;
     if (on != was && (on || count == 0)) {
       set_condition(channel_sensor(c), kSpikes, on, FaultKind::kSpikes, t,
                     std::string(c == kV ? "accelerometer" : "gyro") +
@@ -885,16 +887,17 @@ void Isolator::check_spikes(double t, const Vec2& sw, std::vector<Detection>* ou
 void Isolator::refine_kinds(double t, std::vector<Detection>* out) {
   // Refine the kind once more data after the raise shows the fault's shape.
   for (int k = 0; k < 2; ++k) {
-    if (std::isnan(refine_at_[k]) || t < refine_at_[k]) continue;
-    refine_at_[k] = kNaN;
-    Condition& c = cond_[k];
+    if (std::isnan(chan_[k].refine_at) || t < chan_[k].refine_at) continue;
+    chan_[k].refine_at = kNaN;
+    Condition& c = sens_[k].cond;
     if (!(c.sources & kResidual)) continue;
     if (c.kind != FaultKind::kBias && c.kind != FaultKind::kDrift && c.kind != FaultKind::kScale) {
       continue;
     }
     // Half a classification window of the fault decides better than the raise's window (a
     // noise increase can look offset over the raise's few samples).
-    const FaultKind refined = noise_like(k, raised_at_[k]) ? FaultKind::kNoise : classify_shape(k);
+    const FaultKind refined =
+        noise_like(k, sens_[k].raised_at) ? FaultKind::kNoise : classify_shape(k);
     if (refined == c.kind) continue;
     Detection d = make_detection(static_cast<Sensor>(k), true, refined, t);
     d.update = true;
@@ -912,15 +915,15 @@ Isolator::Levels Isolator::levels(double t, double dt) const {
   lv.ratio = st_.J.cwiseQuotient(lv.thr);  // > 1: above the enter threshold
   for (int c = 0; c < 2; ++c) {
     // refilling or settling after a fault cleared
-    if (act_.win_s[c].size() < lv.n_full || t < resettle_until_[c]) lv.ratio(c) = 0.0;
+    if (act_.win_s[c].size() < lv.n_full || t < chan_[c].resettle_until) lv.ratio(c) = 0.0;
   }
   lv.thr_exit_d = p_.exit_ratio * st_.thresholds_d;
   return lv;
 }
 
 Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
-  const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual,
-             u_res = cond_[2].sources & kResidual;
+  const bool a_res = sens_[0].cond.sources & kResidual, g_res = sens_[1].cond.sources & kResidual,
+             u_res = sens_[2].cond.sources & kResidual;
   Candidate c;
   if (st_.model_mismatch) {
     // Detection resumes once the model holds again: every statistic below its leave
@@ -955,7 +958,7 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
     // fault, on its own channel.
     const int raised = a_res ? 0 : 1, other = 1 - raised;
     if (lv.ratio(other) > 1.0) {
-      if (t - raised_at_[raised] <= p_.mismatch_window) {
+      if (t - sens_[raised].raised_at <= p_.mismatch_window) {
         c.k = 2;
         c.reclassify = raised;
       } else {
@@ -968,17 +971,17 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
 
 void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
                                  std::vector<Detection>* out) {
-  const bool a_res = cond_[0].sources & kResidual, g_res = cond_[1].sources & kResidual;
+  const bool a_res = sens_[0].cond.sources & kResidual, g_res = sens_[1].cond.sources & kResidual;
   const double enter =
       (a_res || g_res) && c.k != 2 ? std::max(p_.enter_time, p_.second_fault_time) : p_.enter_time;
   for (int k = 0; k < 3; ++k) {
     if (k != c.k) {
-      above_since_[k] = kNaN;
+      sens_[k].above_since = kNaN;
       continue;
     }
-    if (std::isnan(above_since_[k])) above_since_[k] = t;
-    if (t - above_since_[k] + kEpsT < enter) continue;
-    above_since_[k] = kNaN;
+    if (std::isnan(sens_[k].above_since)) sens_[k].above_since = t;
+    if (t - sens_[k].above_since + kEpsT < enter) continue;
+    sens_[k].above_since = kNaN;
     if (k == 2) {
       // Model mismatch: a status with its reason, counted; never a latched sensor fault.
       char buf[160];
@@ -995,22 +998,23 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
       mismatch_since_ = t;
       below_mm_since_ = kNaN;
       if (c.reclassify >= 0) {
-        refine_at_[c.reclassify] = kNaN;
-        set_condition(static_cast<Sensor>(c.reclassify), kResidual, false, cond_[c.reclassify].kind,
-                      t, std::string("withdrawn: model mismatch, not a sensor fault: ") + buf, out);
-        below_since_[c.reclassify] = kNaN;
+        chan_[c.reclassify].refine_at = kNaN;
+        set_condition(static_cast<Sensor>(c.reclassify), kResidual, false,
+                      sens_[c.reclassify].cond.kind, t,
+                      std::string("withdrawn: model mismatch, not a sensor fault: ") + buf, out);
+        sens_[c.reclassify].below_since = kNaN;
       }
       continue;
     }
     const Sensor sensor = static_cast<Sensor>(k);
     const FaultKind kind = classify(k);
-    refine_at_[k] = t + 0.5 * p_.classify_window;
+    chan_[k].refine_at = t + 0.5 * p_.classify_window;
     const std::string msg = std::string("residual of the ") + (k == 0 ? "accelerometer" : "gyro") +
                             " channel: J_N " + std::to_string(st_.J(k)) + " > " +
                             std::to_string(lv.thr(k));
     set_condition(sensor, kResidual, true, kind, t, msg, out);
-    raised_at_[k] = t;
-    below_since_[k] = kNaN;
+    sens_[k].raised_at = t;
+    sens_[k].below_since = kNaN;
   }
 }
 
@@ -1019,7 +1023,7 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
   // the other observer), so its structured entry takes the cross residual's scale; the cross
   // residual d_i = y_i - x_i(observer blind to i) carries the fault without absorption.
   for (int k = 0; k < 3; ++k) {
-    if (!(cond_[k].sources & kResidual) || k == c) continue;
+    if (!(sens_[k].cond.sources & kResidual) || k == c) continue;
     // The reconfigured observer's structured entry has about the cross residual's scale.
     const double rescale =
         k < 2 ? std::min(1.0, std::pow(st_.sigma_s(k) / st_.sigma_d(k), 2.0)) : 1.0;
@@ -1031,28 +1035,28 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
       // in the fault's direction (a fault that ended leaves an offset against it), or for
       // zero-mean faults its energy (their aftermath is as short as the observer's memory
       // of the noise). A scale error changes sign with the signal: the cross residual holds.
-      if (mon_on_[k] && mon_ok_[k] && win_m_[k].size() >= lv.n_full) {
+      if (chan_[k].mon_on && chan_[k].mon_ok && chan_[k].win_m.size() >= lv.n_full) {
         hold = std::max(hold, st_.M(k) / (p_.exit_ratio * lv.thr(k)));
       }
     }
     const double leave = k < 2 ? lv.thr_exit_d(k) : p_.exit_ratio * lv.thr.maxCoeff();
     if (hold < 1.0) {
-      if (std::isnan(below_since_[k])) below_since_[k] = t;
-      if (t - below_since_[k] + kEpsT >= p_.leave_time &&
-          t - raised_at_[k] + kEpsT >= p_.min_active_time) {
-        set_condition(static_cast<Sensor>(k), kResidual, false, cond_[k].kind, t,
+      if (std::isnan(sens_[k].below_since)) sens_[k].below_since = t;
+      if (t - sens_[k].below_since + kEpsT >= p_.leave_time &&
+          t - sens_[k].raised_at + kEpsT >= p_.min_active_time) {
+        set_condition(static_cast<Sensor>(k), kResidual, false, sens_[k].cond.kind, t,
                       "residual back below " + std::to_string(leave), out);
-        below_since_[k] = kNaN;
+        sens_[k].below_since = kNaN;
       }
     } else {
-      below_since_[k] = kNaN;
+      sens_[k].below_since = kNaN;
     }
   }
 }
 
 double Isolator::onset_estimate(int ch, double t) const {
   // Walk back over the contiguous run of clearly abnormal structured residuals.
-  const auto& h = hist_s_[ch];
+  const auto& h = chan_[ch].hist_s;
   double onset = t;
   int quiet = 0;
   for (auto it = h.rbegin(); it != h.rend(); ++it) {
@@ -1096,8 +1100,8 @@ FaultKind Isolator::classify_shape(int ch) const {
   // Bias, drift or scale from the cross residual d_i = f_i + noise (the fault estimate):
   // best step  d = a + g 1(t >= tau), best hinge d = a + b max(0, t - tau), best scale
   // d = a + k x 1(t >= tau) (x: the other observer's estimate of the channel).
-  const auto& d = hist_d_[ch];
-  const auto& x = hist_x_[ch];
+  const auto& d = chan_[ch].hist_d;
+  const auto& x = chan_[ch].hist_x;
   const std::size_t m = d.size();
   if (m < 8 || x.size() != m) return FaultKind::kBias;
   // Two-regressor least squares with intercept: SSE of d on [1, z].
@@ -1138,7 +1142,7 @@ bool Isolator::noise_like(int ch, double t_raise) const {
   // healthy) since the raise, against its healthy spread (learned, or the seconds before
   // the raise if larger): a noise increase spreads d without moving it.
   double n0 = 0, s0 = 0, ss0 = 0, n1 = 0, s1 = 0, ss1 = 0;
-  for (const auto& [t, d] : hist_d_[ch]) {
+  for (const auto& [t, d] : chan_[ch].hist_d) {
     if (t < t_raise - 1.0) {
       n0 += 1;
       s0 += d;

@@ -244,6 +244,32 @@ class Isolator {
     double outlier_start = kNaN;
   };
 
+  /// What the residual evaluation keeps of one INS channel (0: v, the accelerometer's; 1: r,
+  /// the gyro's) beside the banks.
+  struct ChannelState {
+    bool resync = false;                           ///< restart the channel's own observer (cleared)
+    double resettle_until = kNaN;                  ///< the restarted observer settles
+    std::deque<std::pair<double, double>> hist_s;  ///< (t, whitened structured residual)
+    std::deque<std::pair<double, double>> hist_d;  ///< (t, raw cross residual)
+    std::deque<std::pair<double, double>> hist_x;  ///< (t, other-observer state)
+    double jump_at = kNaN;                         ///< time of the channel's last jump raise
+    // Holding a raised residual fault (see hold_or_clear).
+    DedicatedObserver mon;    ///< monitor: the observer, not reconfigured
+    bool mon_on = false;      ///< monitor running (channel raised)
+    bool mon_ok = false;      ///< its post-fault transient opposes the fault
+    double mon_sign = 1.0;    ///< the fault's sign at the raise
+    Window win_m;             ///< clipped squared whitened monitor residual
+    Window win_ms;            ///< signed whitened monitor residual
+    double refine_at = kNaN;  ///< when to refine a raised fault's kind
+  };
+  /// The decision's state of one sensor (accelerometer, gyro, unknown).
+  struct SensorState {
+    Condition cond;
+    double above_since = kNaN;  ///< its statistic above the enter threshold since
+    double below_since = kNaN;  ///< ... below the leave threshold since
+    double raised_at = kNaN;    ///< time of the residual raise
+  };
+
   /// One pair of dedicated observers on one design of A, with the residual statistics
   /// learned for that design. The healthy residual of a design carries the model mismatch
   /// of the estimate it was made from, so its scales and thresholds hold for it alone: a
@@ -340,8 +366,6 @@ class Isolator {
   Bank act_;     ///< the bank in force
   Bank shadow_;  ///< a redesign learning beside it
   bool has_shadow_ = false;
-  std::array<bool, 2> resync_{false, false};  ///< restart a channel's own observer (cleared)
-  std::array<double, 2> resettle_until_{kNaN, kNaN};  ///< the restarted observer settles
   bool have_prev_ = false;
   Sample prev_{};
   double t_armed_ = kNaN;
@@ -353,11 +377,8 @@ class Isolator {
   bool freeze_ = false;
   bool data_inconsistent_ = false;  ///< identification's guard keeps the latest data out
   bool scales_configured_ = false;
-  std::array<std::deque<std::pair<double, double>>, 2> hist_s_;  ///< (t, whitened structured)
-  std::array<std::deque<std::pair<double, double>>, 2> hist_d_;  ///< (t, raw cross residual)
-  std::array<std::deque<std::pair<double, double>>, 2> hist_x_;  ///< (t, other-observer state)
-  std::array<Channel, 3> ch_;                                    ///< v, r, delta
-  std::array<JumpCheck, 2> jump_;                                ///< v, r
+  std::array<Channel, 3> ch_;      ///< v, r, delta
+  std::array<JumpCheck, 2> jump_;  ///< v, r
   /// Healthy maxima of J_N and D_N of the bank in force [J_a, J_g, D_a, D_g], learned from
   /// samples once they are older than a raise could be late (history_lag()).
   HealthyMaxima<4> healthy_;
@@ -368,22 +389,11 @@ class Isolator {
   };
   std::deque<PendingStat> pending_stats_;
   double history_lag() const;
-  std::array<double, 2> jump_at_{kNaN, kNaN};  ///< time of each channel's last jump raise
   std::deque<double> timing_errors_;  ///< times of repeated / backward stamps (unknown sensor)
-  std::array<Condition, 3> cond_;     ///< accelerometer, gyro, unknown
-  std::array<double, 3> above_since_{kNaN, kNaN, kNaN};  ///< per sensor a/g/unknown
-  std::array<double, 3> below_since_{kNaN, kNaN, kNaN};
-  std::array<double, 3> raised_at_{kNaN, kNaN, kNaN};  ///< time of the residual raise
   double last_delta_ = kNaN;
-  // Holding a raised residual fault (see residual_checks).
-  std::array<DedicatedObserver, 2> mon_;      ///< monitors: the observer, not reconfigured
-  std::array<bool, 2> mon_on_{false, false};  ///< monitor running (channel raised)
-  std::array<bool, 2> mon_ok_{false, false};  ///< its post-fault transient opposes the fault
-  std::array<double, 2> mon_sign_{1.0, 1.0};  ///< the fault's sign at the raise
-  std::array<Window, 2> win_m_;               ///< clipped squared whitened monitor residual
-  std::array<Window, 2> win_ms_;              ///< signed whitened monitor residual
+  std::array<ChannelState, 2> chan_;  ///< v, r
+  std::array<SensorState, 3> sens_;   ///< accelerometer, gyro, unknown
   void start_monitor(int ch);
-  std::array<double, 2> refine_at_{kNaN, kNaN};  ///< when to refine a raised fault's kind
 };
 
 }  // namespace usvfdi
