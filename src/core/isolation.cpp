@@ -146,6 +146,7 @@ Isolator::Isolator(const IsolationParams& params, const Vec2& B, const SpeedPara
     : p_(validated(params)),
       B_(finite_B(B)),
       speed_(speed),
+      checks_(p_),
       jump_{JumpCheck(p_.jump, B_(0), p_.sigma_floor_v),
             JumpCheck(p_.jump, B_(1), p_.sigma_floor_r)},
       healthy_(10.0, p_.history) {
@@ -381,12 +382,8 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
 bool Isolator::reject_timestamp(std::vector<Detection>* out) {
   ++st_.input.rejected_time;
   if (!have_prev_) return false;
-  // Timing errors count against "unknown", at the last good time (the clock stands still
-  // while stamps are bad: only the latest invalid_count are needed, memory stays bounded).
-  timing_errors_.push_back(prev_.t);
-  prune(&timing_errors_, prev_.t - p_.spike_window);
-  while (static_cast<int>(timing_errors_.size()) > p_.invalid_count) timing_errors_.pop_front();
-  if (static_cast<int>(timing_errors_.size()) >= p_.invalid_count) {
+  // Timing errors count against "unknown", at the last good time.
+  if (checks_.timing_error(prev_.t)) {
     set_condition(Sensor::kUnknown, kInvalid, true, FaultKind::kInvalid, prev_.t,
                   "sample timestamps repeat, go backwards or jump", out);
   }
@@ -396,86 +393,40 @@ bool Isolator::reject_timestamp(std::vector<Detection>* out) {
 }
 
 void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
-  const double values[3] = {s.v, s.r, s.delta};
-  const double limits[3] = {p_.max_abs_v, p_.max_abs_r, p_.max_abs_delta};
-  bool ok[3];
-  for (int c = 0; c < 3; ++c) {
-    Channel& ch = ch_[c];
-    if (std::isnan(ch.last_valid_t)) ch.last_valid_t = s.t;
-    const double x = values[c];
-    const bool missing = std::isnan(x);
-    const bool absurd = !missing && !(std::abs(x) <= limits[c]);  // Inf or out of range
-    if (absurd) {
-      ++st_.input.invalid_values;
-      ch.invalids.push_back(s.t);
-    }
-    prune(&ch.invalids, s.t - p_.spike_window);
-    const bool valid = !missing && !absurd;
-    if (valid) {
-      const bool repeat = x == ch.last_value;
-      if (repeat) {
-        if (ch.stuck_samples == 0) ch.stuck_since = ch.last_valid_t;
-        ++ch.stuck_samples;
-      } else {
-        ch.stuck_samples = 0;
-        ch.stuck_since = kNaN;
-      }
-      // How often this channel repeats a value while it moves (its quantisation), learned
-      // while it is not taken for stuck.
-      if (!(c < 2 && (sens_[c].cond.sources & kStuck)) && std::isfinite(ch.last_value)) {
-        // The mean of the first samples, then an exponential average over stuck_learn_time.
-        ch.repeat_seen += 1.0;
-        const double w = std::max(1.0 / ch.repeat_seen,
-                                  std::min(1.0, (s.t - ch.last_valid_t) / p_.stuck_learn_time));
-        ch.repeat_fraction += w * ((repeat ? 1.0 : 0.0) - ch.repeat_fraction);
-      }
-      ch.last_value = x;
-      ch.last_valid_t = s.t;
-    }
-    const bool stale = s.t - ch.last_valid_t > p_.stale_timeout;
-    const double held = s.t - ch.stuck_since;  // NaN while the value moves
-    bool stuck = false;
-    if (ch.stuck_samples + 1 >= p_.stuck_min_samples && held >= p_.stuck_time) {
-      // Repeats needed: a run this long is improbable for the channel as learned.
-      const double f = std::min(ch.repeat_fraction, 1.0 - 1e-12);
-      const double needed = f > 0.0 ? std::log(p_.stuck_probability) / std::log(f) : 0.0;
-      stuck = ch.stuck_samples >= needed || held >= p_.stuck_time_max;
-    }
-    const bool invalid = static_cast<int>(ch.invalids.size()) >= p_.invalid_count;
-    ok[c] = !stale && !invalid;
-    if (c == 2) continue;  // the rudder is not an INS sensor: it pauses FDI (status flag)
+  // A channel taken for stuck does not learn its repeat fraction from its frozen output.
+  checks_.update(s, {!(sens_[0].cond.sources & kStuck), !(sens_[1].cond.sources & kStuck)},
+                 &st_.input);
+  for (int c = 0; c < 2; ++c) {  // the rudder is not an INS sensor: it pauses FDI (status flag)
+    const SensorChecks::Verdict& v = checks_.verdict(c);
     const Sensor sensor = channel_sensor(c);
-    const char* name = c == kV ? "accelerometer channel v" : "gyro channel r";
-    const bool was_stale = sens_[c].cond.sources & kStale;
-    if (stale != was_stale) {
-      set_condition(sensor, kStale, stale, FaultKind::kStale, s.t,
-                    std::string(name) + (stale ? ": no valid value for " +
-                                                     std::to_string(s.t - ch.last_valid_t) + " s"
-                                               : ": valid values again"),
+    const std::string name = c == kV ? "accelerometer channel v" : "gyro channel r";
+    const unsigned src = sens_[c].cond.sources;
+    if (v.stale != static_cast<bool>(src & kStale)) {
+      set_condition(sensor, kStale, v.stale, FaultKind::kStale, s.t,
+                    name + (v.stale ? ": no valid value for " + std::to_string(v.since_valid) + " s"
+                                    : ": valid values again"),
                     out);
     }
-    const bool was_stuck = sens_[c].cond.sources & kStuck;
-    if (stuck != was_stuck) {
-      set_condition(sensor, kStuck, stuck, FaultKind::kStuck, s.t,
-                    std::string(name) + (stuck ? ": output frozen at " + std::to_string(x)
-                                               : ": output moves again"),
+    if (v.stuck != static_cast<bool>(src & kStuck)) {
+      set_condition(sensor, kStuck, v.stuck, FaultKind::kStuck, s.t,
+                    name + (v.stuck ? ": output frozen at " + std::to_string(v.value)
+                                    : ": output moves again"),
                     out);
     }
-    const bool was_invalid = sens_[c].cond.sources & kInvalid;
-    if (invalid != was_invalid) {
-      set_condition(sensor, kInvalid, invalid, FaultKind::kInvalid, s.t,
-                    std::string(name) + (invalid ? ": repeated non-finite or absurd values"
-                                                 : ": values plausible again"),
+    if (v.invalid != static_cast<bool>(src & kInvalid)) {
+      set_condition(sensor, kInvalid, v.invalid, FaultKind::kInvalid, s.t,
+                    name + (v.invalid ? ": repeated non-finite or absurd values"
+                                      : ": values plausible again"),
                     out);
     }
   }
-  st_.input.v_ok = ok[0] && !(sens_[0].cond.sources & kStuck);
-  st_.input.r_ok = ok[1] && !(sens_[1].cond.sources & kStuck);
-  st_.input.delta_ok = ok[2];
+  const auto ok = [&](int c) { return !checks_.verdict(c).stale && !checks_.verdict(c).invalid; };
+  st_.input.v_ok = ok(0) && !(sens_[0].cond.sources & kStuck);
+  st_.input.r_ok = ok(1) && !(sens_[1].cond.sources & kStuck);
+  st_.input.delta_ok = ok(2);
   if (std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta) last_delta_ = s.delta;
   // Timing errors age out of the unknown channel too.
-  prune(&timing_errors_, s.t - p_.spike_window);
-  if ((sens_[2].cond.sources & kInvalid) && timing_errors_.empty()) {
+  if ((sens_[2].cond.sources & kInvalid) && checks_.timing_clear(s.t)) {
     set_condition(Sensor::kUnknown, kInvalid, false, FaultKind::kInvalid, s.t,
                   "sample timestamps increase again", out);
   }
@@ -853,7 +804,7 @@ void Isolator::check_spikes(double t, const Vec2& sw, std::vector<Detection>* ou
   // Spikes: runs of one or two outliers.
   for (int c = 0; c < 2; ++c) {
     if (!std::isfinite(sw(c))) continue;
-    Channel& ch = ch_[c];
+    ChannelState& ch = chan_[c];
     // A spike is a run of one or two outliers with ordinary samples on both sides.
     const double a = std::abs(sw(c));
     if (a > p_.spike_gate) {
@@ -1072,7 +1023,7 @@ double Isolator::onset_estimate(int ch, double t) const {
 
 FaultKind Isolator::classify(int ch) const {
   // 0. Stuck: the channel repeats its value exactly (a healthy, noisy sensor never does).
-  if (ch_[ch].stuck_samples >= 2) return FaultKind::kStuck;
+  if (checks_.repeats(ch) >= 2) return FaultKind::kStuck;
   // 1. Spikes: the excess energy of the window sits in one or two samples.
   const Window& w = act_.win_sl[ch];
   if (w.empty()) return FaultKind::kUnknown;

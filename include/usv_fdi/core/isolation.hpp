@@ -22,6 +22,7 @@
 #include "usv_fdi/core/identification.hpp"
 #include "usv_fdi/core/jump_check.hpp"
 #include "usv_fdi/core/observer.hpp"
+#include "usv_fdi/core/sensor_checks.hpp"
 #include "usv_fdi/core/speed.hpp"
 #include "usv_fdi/core/types.hpp"
 
@@ -229,20 +230,6 @@ class Isolator {
     kJump = 32u,       ///< the jump check: a sudden offset
     kNoiseRise = 64u,  ///< the jump check: a rise of the noise
   };
-  struct Channel {
-    double last_valid_t = kNaN;
-    double last_value = kNaN;
-    double stuck_since = kNaN;
-    int stuck_samples = 0;
-    double repeat_fraction = 0.0;  ///< learned fraction of samples equal to the previous
-    double repeat_seen = 0;        ///< samples it was learned from (a plain mean at first)
-    std::deque<double> spikes;     ///< times of spikes
-    std::deque<double> invalids;   ///< times of invalid values
-    int outlier_run = 0;
-    bool last_ordinary = true;  ///< the previous residual was well inside the gate
-    bool run_isolated = false;  ///< the current outlier run began after an ordinary sample
-    double outlier_start = kNaN;
-  };
 
   /// What the residual evaluation keeps of one INS channel (0: v, the accelerometer's; 1: r,
   /// the gyro's) beside the banks.
@@ -261,6 +248,12 @@ class Isolator {
     Window win_m;             ///< clipped squared whitened monitor residual
     Window win_ms;            ///< signed whitened monitor residual
     double refine_at = kNaN;  ///< when to refine a raised fault's kind
+    // Spikes of the whitened structured residual (check_spikes).
+    std::deque<double> spikes;  ///< times of spikes
+    int outlier_run = 0;
+    bool last_ordinary = true;  ///< the previous residual was well inside the gate
+    bool run_isolated = false;  ///< the current outlier run began after an ordinary sample
+    double outlier_start = kNaN;
   };
   /// The decision's state of one sensor (accelerometer, gyro, unknown).
   struct SensorState {
@@ -377,7 +370,7 @@ class Isolator {
   bool freeze_ = false;
   bool data_inconsistent_ = false;  ///< identification's guard keeps the latest data out
   bool scales_configured_ = false;
-  std::array<Channel, 3> ch_;      ///< v, r, delta
+  SensorChecks checks_;            ///< stale, stuck, invalid and timing
   std::array<JumpCheck, 2> jump_;  ///< v, r
   /// Healthy maxima of J_N and D_N of the bank in force [J_a, J_g, D_a, D_g], learned from
   /// samples once they are older than a raise could be late (history_lag()).
@@ -389,7 +382,6 @@ class Isolator {
   };
   std::deque<PendingStat> pending_stats_;
   double history_lag() const;
-  std::deque<double> timing_errors_;  ///< times of repeated / backward stamps (unknown sensor)
   double last_delta_ = kNaN;
   std::array<ChannelState, 2> chan_;  ///< v, r
   std::array<SensorState, 3> sens_;   ///< accelerometer, gyro, unknown

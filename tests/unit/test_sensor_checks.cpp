@@ -1,0 +1,101 @@
+// The sensor-level checks (core/sensor_checks.hpp, docs/design.md section 8.4): stale,
+// stuck (with the channel's learned quantisation), invalid, and timing errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "usv_fdi/core/isolation.hpp"
+#include "usv_fdi/core/sensor_checks.hpp"
+
+namespace usvfdi {
+namespace {
+
+constexpr double kDt = 0.1;
+
+struct Feed {
+  SensorChecks checks{IsolationParams{}};
+  InputHealth input;
+  void sample(double t, double v, double r = 0.0, double delta = 0.0) {
+    checks.update(Sample{t, v, r, delta}, {true, true}, &input);
+  }
+};
+
+TEST(SensorChecks, AFullPrecisionChannelHeldForStuckTimeIsStuckAndMovingAgainIsNot) {
+  Feed f;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0.0, 0.01);
+  double t = 0.0;
+  for (; t < 60.0; t += kDt) f.sample(t, n(rng), n(rng));
+  EXPECT_FALSE(f.checks.verdict(kInputV).stuck);
+  const double held = 0.123456;
+  double stuck_at = NAN;
+  for (const double t0 = t; t < t0 + 2.0; t += kDt) {
+    f.sample(t, held, n(rng));
+    if (f.checks.verdict(kInputV).stuck && std::isnan(stuck_at)) stuck_at = t - t0;
+  }
+  ASSERT_FALSE(std::isnan(stuck_at));
+  EXPECT_LE(stuck_at, IsolationParams{}.stuck_time + 2 * kDt);
+  EXPECT_FALSE(f.checks.verdict(kInputR).stuck);  // the other channel moves
+  f.sample(t, held + 0.01, n(rng));
+  EXPECT_FALSE(f.checks.verdict(kInputV).stuck);
+  EXPECT_EQ(f.checks.repeats(kInputV), 0);
+}
+
+TEST(SensorChecks, AQuantisedChannelThatMovesIsNotStuckButAFrozenOneIs) {
+  // A noisy signal printed to 0.01 (its noise about half a quantum): it repeats its value on
+  // about half of the samples, sometimes many times in a row.
+  Feed f;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 0.005);
+  double t = 0.0;
+  bool ever_stuck = false;
+  for (; t < 600.0; t += kDt) {
+    f.sample(t, std::round(100.0 * (0.05 * std::sin(0.05 * t) + n(rng))) / 100.0);
+    ever_stuck = ever_stuck || f.checks.verdict(kInputV).stuck;
+  }
+  EXPECT_FALSE(ever_stuck);
+  // Frozen: caught at the latest after stuck_time_max.
+  bool stuck = false;
+  for (const double t0 = t; t < t0 + IsolationParams{}.stuck_time_max + 0.5; t += kDt) {
+    f.sample(t, 0.42);
+    stuck = f.checks.verdict(kInputV).stuck;
+  }
+  EXPECT_TRUE(stuck);
+}
+
+TEST(SensorChecks, NoValidValueForStaleTimeoutIsStale) {
+  Feed f;
+  f.sample(0.0, 0.1);
+  f.sample(0.1, NAN);
+  EXPECT_FALSE(f.checks.verdict(kInputV).stale);
+  f.sample(0.7, NAN);
+  EXPECT_TRUE(f.checks.verdict(kInputV).stale);
+  EXPECT_NEAR(f.checks.verdict(kInputV).since_valid, 0.7, 1e-12);
+  f.sample(0.8, 0.2);
+  EXPECT_FALSE(f.checks.verdict(kInputV).stale);
+}
+
+TEST(SensorChecks, InvalidCountAbsurdValuesWithinTheWindowAreInvalidAndAgeOut) {
+  Feed f;
+  const IsolationParams p;
+  double t = 0.0;
+  for (int k = 0; k < p.invalid_count; ++k, t += kDt) f.sample(t, 0.0, 1e3);  // |r| > max_abs_r
+  EXPECT_TRUE(f.checks.verdict(kInputR).invalid);
+  EXPECT_FALSE(f.checks.verdict(kInputV).invalid);
+  EXPECT_EQ(f.input.invalid_values, static_cast<std::uint64_t>(p.invalid_count));
+  for (const double t0 = t; t < t0 + p.spike_window + 0.5; t += kDt) f.sample(t, 0.0, 0.01);
+  EXPECT_FALSE(f.checks.verdict(kInputR).invalid);
+}
+
+TEST(SensorChecks, TimingErrorsRaiseAfterInvalidCountAndClearAfterTheWindow) {
+  Feed f;
+  const IsolationParams p;
+  for (int k = 1; k < p.invalid_count; ++k) EXPECT_FALSE(f.checks.timing_error(10.0));
+  EXPECT_TRUE(f.checks.timing_error(10.0));
+  EXPECT_FALSE(f.checks.timing_clear(10.0 + 0.5 * p.spike_window));
+  EXPECT_TRUE(f.checks.timing_clear(10.0 + p.spike_window + 0.1));
+}
+
+}  // namespace
+}  // namespace usvfdi
