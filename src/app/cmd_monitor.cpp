@@ -27,7 +27,6 @@
 namespace usvfdi::app {
 namespace {
 
-namespace dds = usv_fdi::dds;
 using Clock = std::chrono::steady_clock;
 
 void print_table(const FleetView& view) {

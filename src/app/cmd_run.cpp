@@ -52,13 +52,13 @@ class HealthWriter {
   }
   bool enabled() const { return !path_.empty(); }
   void write(const std::string& state, const std::string& reason,
-             const service::FdiService* svc = nullptr) {
+             const dds_service::FdiService* svc = nullptr) {
     if (!enabled()) return;
     r_.time = unix_now();
     r_.state = state;
     r_.reason = reason;
     if (svc != nullptr) {
-      const PipelineStatus st = svc->status();
+      const pipeline::PipelineStatus st = svc->status();
       r_.live = svc->liveness();
       r_.samples = st.samples;
       r_.converged = st.estimate.converged;
@@ -70,14 +70,14 @@ class HealthWriter {
       r_.fault_event_readers = svc->matches().event_readers;
       r_.state_file = svc->state_file();
       r_.state_error = svc->state_error();
-      if (state == "running") service::judge_threads(&r_);
+      if (state == "running") dds_service::judge_threads(&r_);
     }
     if (r_.state == "failed" && r_.reason != logged_failure_) {
       spdlog::error("health: {}", r_.reason);
       logged_failure_ = r_.reason;
     }
     std::string error;
-    if (!service::write_health_file(path_, r_, &error)) {
+    if (!dds_service::write_health_file(path_, r_, &error)) {
       if (error != logged_error_) spdlog::error("health file: {}", error);
       logged_error_ = error;
     } else if (!logged_error_.empty()) {
@@ -88,7 +88,7 @@ class HealthWriter {
 
  private:
   std::string path_;
-  service::HealthReport r_;
+  dds_service::HealthReport r_;
   std::string logged_error_, logged_failure_;
 };
 
@@ -161,9 +161,9 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   // SIGINT/SIGTERM are blocked (run_service_logged) before any thread exists and received
   // with sigtimedwait below: no signal handler, so nothing runs in signal context.
   route_fastdds_log_to_spdlog();
-  service::ServiceConfig cfg;
+  dds_service::ServiceConfig cfg;
   try {
-    cfg = service::load_service_config(a.dds.config);
+    cfg = dds_service::load_service_config(a.dds.config);
     cfg.dds = make_dds_config(a.dds, &cfg.reliable_inputs);
   } catch (const io::ConfigError& e) {
     spdlog::error("{}", e.what());
@@ -191,10 +191,10 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   const double period = cfg.pipeline.status_period;
   HealthWriter health(cfg.health_file, cfg.mmsi, period);
   health.write("starting", "creating the DDS participant");
-  std::unique_ptr<service::FdiService> svc;
+  std::unique_ptr<dds_service::FdiService> svc;
   try {
-    svc = std::make_unique<service::FdiService>(cfg, log_line);
-  } catch (const service::StateInUse& e) {
+    svc = std::make_unique<dds_service::FdiService>(cfg, log_line);
+  } catch (const dds_service::StateInUse& e) {
     // Not a word to the health file: it is the running sidecar's (same configuration).
     spdlog::error("refusing to start: {}", e.what());
     return kExitStateInUse;
@@ -222,7 +222,7 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
       svc->state_file().empty() ? std::string("not persisted") : svc->state_file(),
       cfg.health_file.empty() ? std::string("none") : cfg.health_file);
   int sig = 0;
-  service::FdiService::Matches seen;
+  dds_service::FdiService::Matches seen;
   auto last_health = std::chrono::steady_clock::now();
   while ((sig = wait_for_stop_signal(std::min(0.5, period))) == 0) {
     const auto now = std::chrono::steady_clock::now();
@@ -238,7 +238,7 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
       last_health = now;
       health.write("running", "", svc.get());
     }
-    const service::FdiService::Matches m = svc->matches();
+    const dds_service::FdiService::Matches m = svc->matches();
     if (m != seen) {
       spdlog::info(
           "matched: {} INS writer(s), {} rudder writer(s), {} ack writer(s), {} "
@@ -251,7 +251,7 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   spdlog::info("signal {}: stopping", sig);
   health.write("stopped", "signal " + std::to_string(sig));
   svc->stop();
-  const PipelineStatus st = svc->status();
+  const pipeline::PipelineStatus st = svc->status();
   spdlog::info(
       "stopped in {:.3f} s ({} samples, {} rejected, dropped: {} input, {} identification, {} "
       "output; {} samples of other vessels skipped; {} log lines dropped)",

@@ -152,7 +152,7 @@ int run_sim(const SimArgs& a) {
     std::vector<std::uint32_t> mmsis = a.mmsi;
     if (mmsis.empty() && !a.dds.config.empty()) {
       try {
-        const std::uint32_t m = service::load_service_config(a.dds.config).mmsi;
+        const std::uint32_t m = dds_service::load_service_config(a.dds.config).mmsi;
         if (m != 0) mmsis.push_back(m);
       } catch (const io::ConfigError& e) {
         spdlog::error("{}", e.what());
@@ -198,7 +198,7 @@ int run_sim(const SimArgs& a) {
         spdlog::info("  fault {}", io::format_fault_spec(f));
       vessels.emplace_back(mmsis[i], vc);
     }
-    usv_fdi::dds::DdsConfig dds;
+    usvfdi::dds::DdsConfig dds;
     bool config_reliable = false;  // service.reliable_inputs of --config
     try {
       dds = make_dds_config(a.dds, &config_reliable);

@@ -15,7 +15,6 @@
 
 namespace usvfdi::app {
 
-namespace dds = usv_fdi::dds;
 using Clock = std::chrono::steady_clock;
 
 int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,

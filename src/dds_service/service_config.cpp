@@ -21,7 +21,7 @@
 #define USV_FDI_DEFAULT_QOS_PROFILES ""
 #endif
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 
 using io::ConfigError;
 using io::ConfigValue;
@@ -188,4 +188,4 @@ ServiceConfig load_service_config(const std::string& path) {
   return cfg;
 }
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service
