@@ -3,6 +3,7 @@
 
 #include <cstdint>
 
+#include "usv_fdi/core/isolation.hpp"  // IsolationParams
 #include "usv_fdi/core/latch.hpp"
 #include "usv_fdi/dds/types.hpp"
 #include "usv_fdi/pipeline/pipeline.hpp"
