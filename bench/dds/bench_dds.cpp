@@ -56,7 +56,7 @@ extern char** environ;
 
 namespace {
 
-namespace dds = usv_fdi::dds;
+namespace dds = usvfdi::dds;
 namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
 using Clock = std::chrono::steady_clock;

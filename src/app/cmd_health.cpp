@@ -20,7 +20,7 @@ struct HealthArgs {
 int run_health(const HealthArgs& a) {
   const double now =
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-  const service::HealthVerdict v = service::check_health_file(a.file, a.max_age, now);
+  const dds_service::HealthVerdict v = dds_service::check_health_file(a.file, a.max_age, now);
   std::printf("%s\n", v.line.c_str());
   std::fflush(stdout);
   return v.healthy ? kExitOk : kExitFailure;

@@ -27,7 +27,6 @@
 namespace usvfdi::app {
 namespace {
 
-namespace dds = usv_fdi::dds;
 using Clock = std::chrono::steady_clock;
 
 void print_table(const FleetView& view) {
@@ -154,19 +153,24 @@ int send_acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a,
   return rc;
 }
 
-int run_monitor(const MonitorArgs& a) {
-  block_stop_signals();  // before Fast DDS starts its threads
-  route_fastdds_log_to_spdlog();
-  std::vector<AckRequest> acks;
+/// The --ack specs; false (logged) for a bad one.
+bool parse_acks(const MonitorArgs& a, std::vector<AckRequest>* acks) {
   for (const std::string& spec : a.acks) {
     AckRequest ack;
     std::string why;
     if (!parse_ack(spec, &ack, &why)) {
       spdlog::error("{}", why);
-      return kExitUsage;
+      return false;
     }
-    acks.push_back(ack);
+    acks->push_back(ack);
   }
+  return true;
+}
+
+/// Joins the DDS domain with the fleet view's readers and reads the credentials' validity.
+/// Returns kExitOk, or the exit code after logging why not.
+int join_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
+                std::unique_ptr<FleetView>* view, CredentialExpiry* expiry) {
   dds::DdsConfig cfg;
   try {
     cfg = make_dds_config(a.dds);
@@ -174,63 +178,88 @@ int run_monitor(const MonitorArgs& a) {
     spdlog::error("{}", e.what());
     return kExitConfig;
   }
-  std::unique_ptr<dds::DdsContext> ctx;
-  std::unique_ptr<FleetView> view;
   try {
-    ctx = std::make_unique<dds::DdsContext>(cfg);
-    view = std::make_unique<FleetView>(*ctx, a);
+    *ctx = std::make_unique<dds::DdsContext>(cfg);
+    *view = std::make_unique<FleetView>(**ctx, a);
   } catch (const std::exception& e) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
-  CredentialExpiry expiry;
   try {
-    expiry = credential_expiry(cfg.participant_profile);
+    *expiry = credential_expiry(cfg.participant_profile);
   } catch (const std::exception& e) {
     spdlog::error("DDS Security: {}", e.what());
     return kExitConfig;
   }
-  if (expiry.secure()) spdlog::info("{}", validity_message(expiry));
-  if (expiry.expired(wall_now())) {
-    spdlog::error("{}", expired_message(expiry));
+  if (expiry->secure()) spdlog::info("{}", validity_message(*expiry));
+  if (expiry->expired(wall_now())) {
+    spdlog::error("{}", expired_message(*expiry));
     return kExitFailure;
   }
-  const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
-  if (!a.acks.empty()) {
-    const int rc = send_acks(*ctx, *view, a, acks);
-    if (rc != kExitOk || !keep_watching) return rc;
-  }
+  return kExitOk;
+}
+
+/// Receives until --expect instances are known, --duration (--once: 3 s by default) has
+/// passed or a signal came, printing the table on every change unless --json or --once
+/// (*printed: it was printed). Returns kExitOk, or kExitFailure when the credentials expire.
+int watch(const MonitorArgs& a, FleetView& view, const CredentialExpiry& expiry, bool* printed) {
   const double duration = a.once && a.duration == 0.0 ? 3.0 : a.duration;
   const auto start = Clock::now();
-  bool printed = false;
   for (;;) {
-    const bool changed = view->poll(0.2);
+    const bool changed = view.poll(0.2);
     if (changed && !a.json && !a.once) {
-      print_table(*view);
-      printed = true;
+      print_table(view);
+      *printed = true;
     }
     if (expiry.expired(wall_now())) {  // Fast DDS would keep the session open
       spdlog::error("{}", expired_message(expiry));
       return kExitFailure;
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const bool enough = a.expect > 0 && static_cast<int>(view->rows().size()) >= a.expect;
+    const bool enough = a.expect > 0 && static_cast<int>(view.rows().size()) >= a.expect;
     if (enough || (duration > 0 && elapsed >= duration) || wait_for_stop_signal(0.0) != 0) break;
   }
+  return kExitOk;
+}
+
+/// --once: the latched state of every instance (and each vessel's status), as JSON Lines with
+/// --json, else as the table.
+void print_once(const MonitorArgs& a, const FleetView& view) {
+  if (!a.json) {
+    print_table(view);
+    return;
+  }
+  view.rows().for_each([&](const RowKey&, const Row& r) {
+    std::printf("%s\n", json_row(r, view.heard_age(r.mmsi), wall_now()).c_str());
+  });
+  if (view.vessels() != nullptr) {
+    view.vessels()->for_each([&](const std::uint32_t& m, const VesselStatus& v) {
+      std::printf("%s\n", json_status(v, view.heard_age(m), wall_now()).c_str());
+    });
+  }
+  std::fflush(stdout);
+}
+
+int run_monitor(const MonitorArgs& a) {
+  block_stop_signals();  // before Fast DDS starts its threads
+  route_fastdds_log_to_spdlog();
+  std::vector<AckRequest> acks;
+  if (!parse_acks(a, &acks)) return kExitUsage;
+  std::unique_ptr<dds::DdsContext> ctx;
+  std::unique_ptr<FleetView> view;
+  CredentialExpiry expiry;
+  int rc = join_domain(a, &ctx, &view, &expiry);
+  if (rc != kExitOk) return rc;
+  const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
+  if (!a.acks.empty()) {
+    rc = send_acks(*ctx, *view, a, acks);
+    if (rc != kExitOk || !keep_watching) return rc;
+  }
+  bool printed = false;
+  rc = watch(a, *view, expiry, &printed);
+  if (rc != kExitOk) return rc;
   if (a.once) {
-    if (a.json) {
-      view->rows().for_each([&](const RowKey&, const Row& r) {
-        std::printf("%s\n", json_row(r, view->heard_age(r.mmsi), wall_now()).c_str());
-      });
-      if (view->vessels() != nullptr) {
-        view->vessels()->for_each([&](const std::uint32_t& m, const VesselStatus& v) {
-          std::printf("%s\n", json_status(v, view->heard_age(m), wall_now()).c_str());
-        });
-      }
-      std::fflush(stdout);
-    } else {
-      print_table(*view);
-    }
+    print_once(a, *view);
   } else if (!a.json && !printed) {
     print_table(*view);
   }

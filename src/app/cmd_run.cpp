@@ -52,13 +52,13 @@ class HealthWriter {
   }
   bool enabled() const { return !path_.empty(); }
   void write(const std::string& state, const std::string& reason,
-             const service::FdiService* svc = nullptr) {
+             const dds_service::FdiService* svc = nullptr) {
     if (!enabled()) return;
     r_.time = unix_now();
     r_.state = state;
     r_.reason = reason;
     if (svc != nullptr) {
-      const PipelineStatus st = svc->status();
+      const pipeline::PipelineStatus st = svc->status();
       r_.live = svc->liveness();
       r_.samples = st.samples;
       r_.converged = st.estimate.converged;
@@ -70,14 +70,14 @@ class HealthWriter {
       r_.fault_event_readers = svc->matches().event_readers;
       r_.state_file = svc->state_file();
       r_.state_error = svc->state_error();
-      if (state == "running") service::judge_threads(&r_);
+      if (state == "running") dds_service::judge_threads(&r_);
     }
     if (r_.state == "failed" && r_.reason != logged_failure_) {
       spdlog::error("health: {}", r_.reason);
       logged_failure_ = r_.reason;
     }
     std::string error;
-    if (!service::write_health_file(path_, r_, &error)) {
+    if (!dds_service::write_health_file(path_, r_, &error)) {
       if (error != logged_error_) spdlog::error("health file: {}", error);
       logged_error_ = error;
     } else if (!logged_error_.empty()) {
@@ -88,7 +88,7 @@ class HealthWriter {
 
  private:
   std::string path_;
-  service::HealthReport r_;
+  dds_service::HealthReport r_;
   std::string logged_error_, logged_failure_;
 };
 
@@ -157,13 +157,12 @@ void log_line(int level, const std::string& msg) {
   }
 }
 
-int run_service(const RunArgs& a, const AsyncLogging& logging) {
-  // SIGINT/SIGTERM are blocked (run_service_logged) before any thread exists and received
-  // with sigtimedwait below: no signal handler, so nothing runs in signal context.
-  route_fastdds_log_to_spdlog();
-  service::ServiceConfig cfg;
+/// The sidecar's configuration: --config, then the command line's overrides. Returns kExitOk,
+/// or kExitConfig after logging why it does not fit.
+int load_run_config(const RunArgs& a, dds_service::ServiceConfig* out) {
+  dds_service::ServiceConfig& cfg = *out;
   try {
-    cfg = service::load_service_config(a.dds.config);
+    cfg = dds_service::load_service_config(a.dds.config);
     cfg.dds = make_dds_config(a.dds, &cfg.reliable_inputs);
   } catch (const io::ConfigError& e) {
     spdlog::error("{}", e.what());
@@ -188,57 +187,66 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   if (a.root == nullptr || a.root->get_option("--log-level")->count() == 0) {
     spdlog::set_level(spdlog::level::from_str(cfg.log_level));
   }
-  const double period = cfg.pipeline.status_period;
-  HealthWriter health(cfg.health_file, cfg.mmsi, period);
-  health.write("starting", "creating the DDS participant");
-  std::unique_ptr<service::FdiService> svc;
+  return kExitOk;
+}
+
+/// Creates the service (every DDS entity, the pipeline) and reads the credentials' validity.
+/// Returns kExitOk, or the exit code after logging (and writing to the health file) why not.
+int create_service(const dds_service::ServiceConfig& cfg, HealthWriter* health,
+                   std::unique_ptr<dds_service::FdiService>* svc, CredentialExpiry* expiry) {
   try {
-    svc = std::make_unique<service::FdiService>(cfg, log_line);
-  } catch (const service::StateInUse& e) {
+    *svc = std::make_unique<dds_service::FdiService>(cfg, log_line);
+  } catch (const dds_service::StateInUse& e) {
     // Not a word to the health file: it is the running sidecar's (same configuration).
     spdlog::error("refusing to start: {}", e.what());
     return kExitStateInUse;
   } catch (const std::exception& e) {
     spdlog::error("cannot start the DDS service: {}", e.what());
-    health.write("failed", std::string("cannot start the DDS service: ") + e.what());
+    health->write("failed", std::string("cannot start the DDS service: ") + e.what());
     return kExitFailure;
   }
-  CredentialExpiry expiry;  // Fast DDS checks it at the handshake only: watched here
-  try {
-    expiry = credential_expiry(cfg.dds.participant_profile);
+  try {  // Fast DDS checks it at the handshake only: watched while running
+    *expiry = credential_expiry(cfg.dds.participant_profile);
   } catch (const std::exception& e) {
     spdlog::error("DDS Security: {}", e.what());
-    health.write("failed", std::string("DDS Security: ") + e.what());
+    health->write("failed", std::string("DDS Security: ") + e.what());
     return kExitConfig;
   }
-  if (expiry.secure()) spdlog::info("{}", validity_message(expiry));
-  svc->start();
-  health.write("running", "", svc.get());
+  if (expiry->secure()) spdlog::info("{}", validity_message(*expiry));
+  return kExitOk;
+}
+
+void log_started(const dds_service::ServiceConfig& cfg, const dds_service::FdiService& svc) {
   spdlog::info(
       "sidecar for MMSI {} (incarnation {}) on DDS domain {} (participant profile {}, QoS {}, "
       "{} inputs, status every {:g} s, state {}, health file {}): waiting for INS and rudder",
-      cfg.mmsi, svc->incarnation(), cfg.dds.domain_id, cfg.dds.participant_profile,
-      cfg.dds.profiles_file, cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT", period,
-      svc->state_file().empty() ? std::string("not persisted") : svc->state_file(),
+      cfg.mmsi, svc.incarnation(), cfg.dds.domain_id, cfg.dds.participant_profile,
+      cfg.dds.profiles_file, cfg.reliable_inputs ? "RELIABLE" : "BEST_EFFORT",
+      cfg.pipeline.status_period,
+      svc.state_file().empty() ? std::string("not persisted") : svc.state_file(),
       cfg.health_file.empty() ? std::string("none") : cfg.health_file);
-  int sig = 0;
-  service::FdiService::Matches seen;
+}
+
+/// Runs until SIGINT or SIGTERM (*sig), writing the health file every status period and
+/// logging every change of the matched endpoints. Returns kExitOk, or kExitFailure (the
+/// service stopped) when the credentials expire.
+int watch_until_signal(dds_service::FdiService* svc, HealthWriter* health,
+                       const CredentialExpiry& expiry, double period, int* sig) {
+  dds_service::FdiService::Matches seen;
   auto last_health = std::chrono::steady_clock::now();
-  while ((sig = wait_for_stop_signal(std::min(0.5, period))) == 0) {
+  while ((*sig = wait_for_stop_signal(std::min(0.5, period))) == 0) {
     const auto now = std::chrono::steady_clock::now();
-    if (expiry.expired(
-            std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-                .count())) {
+    if (expiry.expired(unix_now())) {
       spdlog::error("{}", expired_message(expiry));
-      health.write("failed", expired_message(expiry));
+      health->write("failed", expired_message(expiry));
       svc->stop();
       return kExitFailure;
     }
     if (std::chrono::duration<double>(now - last_health).count() >= period) {
       last_health = now;
-      health.write("running", "", svc.get());
+      health->write("running", "", svc);
     }
-    const service::FdiService::Matches m = svc->matches();
+    const dds_service::FdiService::Matches m = svc->matches();
     if (m != seen) {
       spdlog::info(
           "matched: {} INS writer(s), {} rudder writer(s), {} ack writer(s), {} "
@@ -247,17 +255,46 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
       seen = m;
     }
   }
+  return kExitOk;
+}
+
+/// Stops the service after signal `sig` and logs what it did.
+void stop_service(int sig, dds_service::FdiService* svc, HealthWriter* health,
+                  const AsyncLogging& logging) {
   const auto t0 = std::chrono::steady_clock::now();
   spdlog::info("signal {}: stopping", sig);
-  health.write("stopped", "signal " + std::to_string(sig));
+  health->write("stopped", "signal " + std::to_string(sig));
   svc->stop();
-  const PipelineStatus st = svc->status();
+  const pipeline::PipelineStatus st = svc->status();
   spdlog::info(
       "stopped in {:.3f} s ({} samples, {} rejected, dropped: {} input, {} identification, {} "
       "output; {} samples of other vessels skipped; {} log lines dropped)",
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), st.samples,
       st.rejected, st.dropped_inputs, st.dropped_ident, st.dropped_output, svc->foreign_samples(),
       logging.dropped());
+}
+
+int run_service(const RunArgs& a, const AsyncLogging& logging) {
+  // SIGINT/SIGTERM are blocked (run_service_logged) before any thread exists and received
+  // with sigtimedwait below: no signal handler, so nothing runs in signal context.
+  route_fastdds_log_to_spdlog();
+  dds_service::ServiceConfig cfg;
+  int rc = load_run_config(a, &cfg);
+  if (rc != kExitOk) return rc;
+  const double period = cfg.pipeline.status_period;
+  HealthWriter health(cfg.health_file, cfg.mmsi, period);
+  health.write("starting", "creating the DDS participant");
+  std::unique_ptr<dds_service::FdiService> svc;
+  CredentialExpiry expiry;
+  rc = create_service(cfg, &health, &svc, &expiry);
+  if (rc != kExitOk) return rc;
+  svc->start();
+  health.write("running", "", svc.get());
+  log_started(cfg, *svc);
+  int sig = 0;
+  rc = watch_until_signal(svc.get(), &health, expiry, period, &sig);
+  if (rc != kExitOk) return rc;
+  stop_service(sig, svc.get(), &health, logging);
   return kExitOk;
 }
 

@@ -100,15 +100,17 @@ int run_voyage_scenario(const SimArgs& a) {
   return run_voyage_sim(a, a.voyage);
 }
 
-int run_sim(const SimArgs& a) {
-  if (!is_classic(a.scenario)) return run_voyage_scenario(a);
-  VesselModel vessel;
-  if (!find_vessel(a.vessel, &vessel)) {
+/// Faults given as MMSI@spec: for that vessel only (--publish).
+using TargetedFaults = std::map<std::uint32_t, std::vector<FaultInjection>>;
+
+/// The shipped vessel a classic scenario runs; false (logged) when the options do not fit one.
+bool classic_vessel(const SimArgs& a, VesselModel* vessel) {
+  if (!find_vessel(a.vessel, vessel)) {
     spdlog::error(
         "--vessel '{}': the classic scenarios (paper, healthy, faults) run the shipped "
         "vessels only; give a voyage scenario (--scenario course, voyage, ...)",
         a.vessel);
-    return kExitUsage;
+    return false;
   }
   if (a.voyage.any()) {
     spdlog::error(
@@ -116,9 +118,16 @@ int run_sim(const SimArgs& a) {
         "--dither need a voyage scenario (course, zigzag10, zigzag20, turn, speed, "
         "slow, voyage, hold), not '{}'",
         a.scenario);
-    return kExitUsage;
+    return false;
   }
-  SimConfig c;
+  return true;
+}
+
+/// The classic scenario with the options applied: the --fault specs without MMSI@ join its
+/// faults, the others go to *targeted. False (logged) for a bad --fault.
+bool classic_config(const SimArgs& a, const VesselModel& vessel, SimConfig* config,
+                    TargetedFaults* targeted) {
+  SimConfig& c = *config;
   if (a.scenario == "paper") {
     c = paper_scenario(vessel, a.rate_hz, a.seed);
   } else if (a.scenario == "healthy") {
@@ -126,19 +135,18 @@ int run_sim(const SimArgs& a) {
   } else {
     c = io::faults_scenario(vessel, a.rate_hz, a.seed);
   }
-  std::map<std::uint32_t, std::vector<FaultInjection>> targeted;  ///< MMSI@ faults
   for (const std::string& text : a.faults) {
     FaultInjection f;
     std::string why, spec;
     std::uint32_t target = 0;
     if (!split_fault_target(text, &target, &spec, &why) || !io::parse_fault_spec(spec, &f, &why)) {
       spdlog::error("--fault: {}", why);
-      return kExitUsage;
+      return false;
     }
     if (target == 0) {
       c.faults.push_back(f);
     } else {
-      targeted[target].push_back(f);
+      (*targeted)[target].push_back(f);
     }
   }
   if (a.duration) c.duration = *a.duration;
@@ -146,80 +154,98 @@ int run_sim(const SimArgs& a) {
   if (a.steering == "sine") c.steering = Steering::kSine;
   c.sigma_v = a.noise_scale * vessel.sigma_v;
   c.sigma_r = a.noise_scale * vessel.sigma_r;
+  return true;
+}
 
 #ifdef USV_FDI_APP_WITH_DDS
-  if (a.publish) {
-    std::vector<std::uint32_t> mmsis = a.mmsi;
-    if (mmsis.empty() && !a.dds.config.empty()) {
-      try {
-        const std::uint32_t m = service::load_service_config(a.dds.config).mmsi;
-        if (m != 0) mmsis.push_back(m);
-      } catch (const io::ConfigError& e) {
-        spdlog::error("{}", e.what());
-        return kExitConfig;
-      }
-    }
-    if (mmsis.empty()) {
-      spdlog::error(
-          "--publish needs the vessels' MMSIs: --mmsi (repeatable) or service.mmsi in --config");
-      return kExitUsage;
-    }
-    const std::set<std::uint32_t> unique(mmsis.begin(), mmsis.end());
-    if (unique.size() != mmsis.size()) {
-      spdlog::error("--mmsi: every vessel needs its own MMSI (a value is repeated)");
-      return kExitUsage;
-    }
-    for (const auto& kv : targeted) {
-      if (!unique.count(kv.first)) {
-        spdlog::error("--fault {}@...: {} is not one of the published vessels (--mmsi)", kv.first,
-                      kv.first);
-        return kExitUsage;
-      }
-    }
-    for (const std::uint32_t h : a.healthy) {
-      if (!unique.count(h)) {
-        spdlog::error("--healthy {}: not one of the published vessels (--mmsi)", h);
-        return kExitUsage;
-      }
-    }
-    std::vector<std::pair<std::uint32_t, SimConfig>> vessels;
-    for (std::size_t i = 0; i < mmsis.size(); ++i) {
-      SimConfig vc = c;
-      vc.seed = c.seed + i;  // independent noise per vessel
-      if (std::find(a.healthy.begin(), a.healthy.end(), mmsis[i]) != a.healthy.end()) {
-        vc.faults.clear();
-      }
-      const auto it = targeted.find(mmsis[i]);
-      if (it != targeted.end())
-        vc.faults.insert(vc.faults.end(), it->second.begin(), it->second.end());
-      spdlog::info("vessel MMSI {}: {} {} Hz {} s seed {}", mmsis[i], vessel.name, vc.rate_hz,
-                   vc.duration, vc.seed);
-      for (const FaultInjection& f : vc.faults)
-        spdlog::info("  fault {}", io::format_fault_spec(f));
-      vessels.emplace_back(mmsis[i], vc);
-    }
-    usv_fdi::dds::DdsConfig dds;
-    bool config_reliable = false;  // service.reliable_inputs of --config
+/// The vessels --publish simulates: --mmsi, else service.mmsi of --config. Returns kExitOk,
+/// or the exit code after logging why they do not fit (also MMSI@ faults and --healthy that
+/// name none of them).
+int published_mmsis(const SimArgs& a, const TargetedFaults& targeted,
+                    std::vector<std::uint32_t>* out) {
+  std::vector<std::uint32_t>& mmsis = *out;
+  mmsis = a.mmsi;
+  if (mmsis.empty() && !a.dds.config.empty()) {
     try {
-      dds = make_dds_config(a.dds, &config_reliable);
+      const std::uint32_t m = dds_service::load_service_config(a.dds.config).mmsi;
+      if (m != 0) mmsis.push_back(m);
     } catch (const io::ConfigError& e) {
       spdlog::error("{}", e.what());
       return kExitConfig;
     }
-    PublishOptions opt = a.pub;
-    opt.reliable = a.pub.reliable || config_reliable;
-    return publish_simulation(vessels, dds, opt);
   }
-#endif
-  if (a.output.empty()) {
-    spdlog::error("sim: give --output FILE (or --publish)");
+  if (mmsis.empty()) {
+    spdlog::error(
+        "--publish needs the vessels' MMSIs: --mmsi (repeatable) or service.mmsi in --config");
     return kExitUsage;
   }
-  if (!targeted.empty() || !a.healthy.empty()) {
-    spdlog::error("sim: MMSI@ faults and --healthy only apply with --publish");
+  const std::set<std::uint32_t> unique(mmsis.begin(), mmsis.end());
+  if (unique.size() != mmsis.size()) {
+    spdlog::error("--mmsi: every vessel needs its own MMSI (a value is repeated)");
     return kExitUsage;
   }
+  for (const auto& kv : targeted) {
+    if (!unique.count(kv.first)) {
+      spdlog::error("--fault {}@...: {} is not one of the published vessels (--mmsi)", kv.first,
+                    kv.first);
+      return kExitUsage;
+    }
+  }
+  for (const std::uint32_t h : a.healthy) {
+    if (!unique.count(h)) {
+      spdlog::error("--healthy {}: not one of the published vessels (--mmsi)", h);
+      return kExitUsage;
+    }
+  }
+  return kExitOk;
+}
 
+/// One simulation per vessel: seed + i, without the shared faults if --healthy, with its own
+/// MMSI@ faults.
+std::vector<std::pair<std::uint32_t, SimConfig>> vessel_simulations(
+    const SimArgs& a, const VesselModel& vessel, const SimConfig& c,
+    const std::vector<std::uint32_t>& mmsis, const TargetedFaults& targeted) {
+  std::vector<std::pair<std::uint32_t, SimConfig>> vessels;
+  for (std::size_t i = 0; i < mmsis.size(); ++i) {
+    SimConfig vc = c;
+    vc.seed = c.seed + i;  // independent noise per vessel
+    if (std::find(a.healthy.begin(), a.healthy.end(), mmsis[i]) != a.healthy.end()) {
+      vc.faults.clear();
+    }
+    const auto it = targeted.find(mmsis[i]);
+    if (it != targeted.end())
+      vc.faults.insert(vc.faults.end(), it->second.begin(), it->second.end());
+    spdlog::info("vessel MMSI {}: {} {} Hz {} s seed {}", mmsis[i], vessel.name, vc.rate_hz,
+                 vc.duration, vc.seed);
+    for (const FaultInjection& f : vc.faults) spdlog::info("  fault {}", io::format_fault_spec(f));
+    vessels.emplace_back(mmsis[i], vc);
+  }
+  return vessels;
+}
+
+/// --publish: the classic scenario on DDS for every vessel (sim_publish.cpp).
+int publish_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig& c,
+                    const TargetedFaults& targeted) {
+  std::vector<std::uint32_t> mmsis;
+  const int rc = published_mmsis(a, targeted, &mmsis);
+  if (rc != kExitOk) return rc;
+  const auto vessels = vessel_simulations(a, vessel, c, mmsis, targeted);
+  usvfdi::dds::DdsConfig dds;
+  bool config_reliable = false;  // service.reliable_inputs of --config
+  try {
+    dds = make_dds_config(a.dds, &config_reliable);
+  } catch (const io::ConfigError& e) {
+    spdlog::error("{}", e.what());
+    return kExitConfig;
+  }
+  PublishOptions opt = a.pub;
+  opt.reliable = a.pub.reliable || config_reliable;
+  return publish_simulation(vessels, dds, opt);
+}
+#endif
+
+/// The classic scenario into the --output CSV (a temporary file renamed at the end).
+int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
   std::unique_ptr<Simulator> sim;
   try {
     sim = std::make_unique<Simulator>(c);
@@ -227,9 +253,7 @@ int run_sim(const SimArgs& a) {
     spdlog::error("{}", e.what());
     return kExitUsage;
   }
-
   const bool to_stdout = a.output == "-";
-  // A temporary file renamed at the end.
   const std::unique_ptr<io::OutputFile> output = open_output(a.output);
   if (output == nullptr) return kExitOutput;
   io::SimCsvWriter writer(output->stream());
@@ -256,16 +280,29 @@ int run_sim(const SimArgs& a) {
   return kExitOk;
 }
 
-}  // namespace
+int run_sim(const SimArgs& a) {
+  if (!is_classic(a.scenario)) return run_voyage_scenario(a);
+  VesselModel vessel;
+  if (!classic_vessel(a, &vessel)) return kExitUsage;
+  SimConfig c;
+  TargetedFaults targeted;
+  if (!classic_config(a, vessel, &c, &targeted)) return kExitUsage;
+#ifdef USV_FDI_APP_WITH_DDS
+  if (a.publish) return publish_classic(a, vessel, c, targeted);
+#endif
+  if (a.output.empty()) {
+    spdlog::error("sim: give --output FILE (or --publish)");
+    return kExitUsage;
+  }
+  if (!targeted.empty() || !a.healthy.empty()) {
+    spdlog::error("sim: MMSI@ faults and --healthy only apply with --publish");
+    return kExitUsage;
+  }
+  return write_classic_csv(a, vessel, c);
+}
 
-void register_sim_command(CommandRegistry& registry) {
-  auto args = std::make_shared<SimArgs>();
-  CLI::App* sub =
-      registry.add("sim",
-                   "Simulate a vessel with optional INS faults and write CSV rows "
-                   "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
-                   "scenarios add u and more; %.17g)",
-                   [args] { return run_sim(*args); });
+/// --vessel, --scenario, --rate, --duration, --seed, --fault.
+void add_scenario_options(CLI::App* sub, SimArgs* args) {
   std::vector<std::string> names;
   for (const VesselModel& m : shipped_vessels()) names.push_back(m.name);
   for (const std::string& n : voyage_vessel_names()) {
@@ -297,15 +334,11 @@ void register_sim_command(CommandRegistry& registry) {
                   "extra fault [MMSI@]sensor:kind:start:end[:magnitude[:spike_rate]] "
                   "(e.g. gyro:bias:20:40:0.005; MMSI@ limits it to one vessel with --publish); "
                   "repeatable");
-  add_voyage_options(sub, &args->voyage);
-  sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
-      ->check(CLI::IsMember({"autopilot", "sine"}));
-  sub->add_option("--noise-scale", args->noise_scale,
-                  "factor on the vessel's realistic sensor noise (0: noise-free)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+}
+
 #ifdef USV_FDI_APP_WITH_DDS
-  sub->add_option("--output", args->output, "output CSV ('-': stdout); or --publish");
+/// --publish and the options that go with it, then the DDS options.
+void add_publish_options(CLI::App* sub, SimArgs* args) {
   sub->add_flag("--publish", args->publish,
                 "publish INS and rudder samples on DDS instead of writing a CSV");
   sub->add_option("--mmsi", args->mmsi,
@@ -335,6 +368,30 @@ void register_sim_command(CommandRegistry& registry) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   add_dds_options(sub, &args->dds);
+}
+#endif
+
+}  // namespace
+
+void register_sim_command(CommandRegistry& registry) {
+  auto args = std::make_shared<SimArgs>();
+  CLI::App* sub =
+      registry.add("sim",
+                   "Simulate a vessel with optional INS faults and write CSV rows "
+                   "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
+                   "scenarios add u and more; %.17g)",
+                   [args] { return run_sim(*args); });
+  add_scenario_options(sub, args.get());
+  add_voyage_options(sub, &args->voyage);
+  sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
+      ->check(CLI::IsMember({"autopilot", "sine"}));
+  sub->add_option("--noise-scale", args->noise_scale,
+                  "factor on the vessel's realistic sensor noise (0: noise-free)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+#ifdef USV_FDI_APP_WITH_DDS
+  sub->add_option("--output", args->output, "output CSV ('-': stdout); or --publish");
+  add_publish_options(sub, args.get());
 #else
   sub->add_option("--output", args->output, "output CSV ('-': stdout)")->required();
 #endif

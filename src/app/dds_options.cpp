@@ -27,16 +27,16 @@ void add_dds_options(CLI::App* sub, DdsCli* cli, bool with_config) {
   sub->add_option("--partition", cli->partitions, "DDS partition (repeatable)");
 }
 
-usv_fdi::dds::DdsConfig make_dds_config(const DdsCli& cli, bool* reliable_inputs) {
-  usv_fdi::dds::DdsConfig d;
+usvfdi::dds::DdsConfig make_dds_config(const DdsCli& cli, bool* reliable_inputs) {
+  usvfdi::dds::DdsConfig d;
   bool reliable = cli.reliable;
   if (!cli.config.empty()) {
-    const service::ServiceConfig s = service::load_service_config(cli.config);
+    const dds_service::ServiceConfig s = dds_service::load_service_config(cli.config);
     d = s.dds;
     reliable = reliable || s.reliable_inputs;
   } else {
     // Same defaults as a config without a service section.
-    d.profiles_file = service::default_qos_profiles();
+    d.profiles_file = dds_service::default_qos_profiles();
   }
   if (cli.domain) d.domain_id = *cli.domain;
   if (!cli.qos.empty()) d.profiles_file = cli.qos;

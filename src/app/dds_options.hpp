@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 struct DdsConfig;
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds
 
 namespace usvfdi::app {
 
@@ -29,7 +29,7 @@ void add_dds_options(CLI::App* sub, DdsCli* cli, bool with_config = true);
 
 /// The DDS settings: from --config's service section if given, then the explicit options.
 /// Throws usvfdi::io::ConfigError for a bad config file.
-usv_fdi::dds::DdsConfig make_dds_config(const DdsCli& cli, bool* reliable_inputs = nullptr);
+usvfdi::dds::DdsConfig make_dds_config(const DdsCli& cli, bool* reliable_inputs = nullptr);
 
 /// Blocks SIGINT and SIGTERM in the calling thread and every thread it creates afterwards,
 /// so that wait_for_stop_signal() can receive them with sigtimedwait (no handler, no I/O in

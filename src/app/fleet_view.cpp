@@ -6,8 +6,6 @@
 
 namespace usvfdi::app {
 
-namespace dds = usv_fdi::dds;
-
 std::string writer_name(const dds::DdsContext& ctx, const fdds::InstanceHandle_t& h) {
   std::ostringstream os;
   os << eprosima::fastrtps::rtps::iHandle2GUID(h);

@@ -27,7 +27,6 @@
 namespace usvfdi::app {
 
 namespace fdds = eprosima::fastdds::dds;
-namespace dds = usv_fdi::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
 
 /// Records the writers (sidecars) that went away: Fast DDS 2.9 neither delivers an
@@ -117,7 +116,7 @@ class FleetView {
       changed |= heard(d.mmsi());
       Row r;
       r.mmsi = d.mmsi();
-      if (!service::from_dds(d, &r.ev)) {
+      if (!dds_service::from_dds(d, &r.ev)) {
         spdlog::warn("ignored a FaultEvent from MMSI {} with unknown sensor/state/kind octets",
                      d.mmsi());
         continue;

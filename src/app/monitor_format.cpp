@@ -7,7 +7,7 @@
 
 #include "usv_fdi/core/text.hpp"
 #include "usv_fdi/io/jsonl.hpp"
-#include "usv_fdi/service/pipeline.hpp"
+#include "usv_fdi/pipeline/pipeline.hpp"
 
 namespace usvfdi::app {
 
@@ -23,7 +23,7 @@ std::string json_row(const Row& r, double heard_age, double now) {
 }
 
 std::string inputs_line(const fdi::FdiStatus& s) {
-  std::string flags = input_flag_names(s.input_flags());
+  std::string flags = pipeline::input_flag_names(s.input_flags());
   char counts[200];
   std::snprintf(counts, sizeof counts,
                 "rejected timestamps %llu, invalid values %llu, gaps %llu, reordered %llu, queue "
@@ -34,12 +34,13 @@ std::string inputs_line(const fdi::FdiStatus& s) {
                 static_cast<unsigned long long>(s.reordered()),
                 static_cast<unsigned long long>(s.dropped_inputs()));
   std::string line = "inputs: " + (flags.empty() ? std::string("ok") : flags) + " (" + counts + ")";
-  line += s.identification_paused() == 0
-              ? std::string("; identification running")
-              : "; identification paused: " + pause_reason_names(s.identification_paused());
+  line +=
+      s.identification_paused() == 0
+          ? std::string("; identification running")
+          : "; identification paused: " + pipeline::pause_reason_names(s.identification_paused());
   line += s.isolation_paused() == 0
               ? std::string("; isolation running")
-              : "; isolation paused: " + pause_reason_names(s.isolation_paused());
+              : "; isolation paused: " + pipeline::pause_reason_names(s.isolation_paused());
   return line;
 }
 
@@ -55,13 +56,14 @@ std::string json_status(const VesselStatus& v, double heard_age, double now) {
      << ",\"ins_healthy\":" << (s.ins_healthy() ? "true" : "false")
      << ",\"rudder_healthy\":" << (s.rudder_healthy() ? "true" : "false")
      << ",\"samples\":" << s.samples() << ",\"dropped\":" << s.dropped()
-     << ",\"input_flags\":" << io::json_string_array(input_flag_names(s.input_flags()))
+     << ",\"input_flags\":" << io::json_string_array(pipeline::input_flag_names(s.input_flags()))
      << ",\"rejected_timestamps\":" << s.rejected_timestamps()
      << ",\"invalid_values\":" << s.invalid_values() << ",\"gaps\":" << s.gaps()
      << ",\"reordered\":" << s.reordered() << ",\"dropped_inputs\":" << s.dropped_inputs()
      << ",\"identification_paused\":"
-     << io::json_string_array(pause_reason_names(s.identification_paused()))
-     << ",\"isolation_paused\":" << io::json_string_array(pause_reason_names(s.isolation_paused()))
+     << io::json_string_array(pipeline::pause_reason_names(s.identification_paused()))
+     << ",\"isolation_paused\":"
+     << io::json_string_array(pipeline::pause_reason_names(s.isolation_paused()))
      << ",\"age_s\":" << io::json_number(now - v.written)
      << ",\"heard_age_s\":" << io::json_number(heard_age)
      << ",\"alive\":" << (v.alive ? "true" : "false")

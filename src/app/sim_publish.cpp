@@ -15,11 +15,224 @@
 
 namespace usvfdi::app {
 
-namespace dds = usv_fdi::dds;
 using Clock = std::chrono::steady_clock;
 
-int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,
-                       const dds::DdsConfig& cfg, const PublishOptions& opt) {
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+using eprosima::fastrtps::Duration_t;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+/// With RELIABLE writers, wait for the readers' acknowledgements every this many samples
+/// (half the writers' 256-deep history).
+constexpr std::uint64_t kAckEvery = 128;
+
+Clock::duration wall_duration(double seconds) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+struct Writers {
+  fdds::DataWriter* ins = nullptr;
+  fdds::DataWriter* rudder = nullptr;
+};
+
+/// The INS and rudder writers; false (logged) when Fast DDS refuses one.
+bool create_writers(dds::DdsContext& ctx, bool reliable, Writers* w) {
+  try {
+    w->ins = &ctx.create_writer(dds::TopicId::kIns, reliable ? dds::profiles::kInsWriterReliable
+                                                             : dds::profiles::kInsWriterBestEffort);
+    w->rudder = &ctx.create_writer(
+        dds::TopicId::kRudder,
+        reliable ? dds::profiles::kRudderWriterReliable : dds::profiles::kRudderWriterBestEffort);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return false;
+  }
+  return true;
+}
+
+/// Bounded wait (until wait_end) for the sidecars, so that the first seconds of the voyage are
+/// not lost. False: a stop signal came.
+bool wait_for_readers(const Writers& w, const PublishOptions& opt, std::uint32_t domain,
+                      Clock::time_point wait_end) {
+  fdds::PublicationMatchedStatus mi, mr;
+  for (;;) {
+    w.ins->get_publication_matched_status(mi);
+    w.rudder->get_publication_matched_status(mr);
+    if ((mi.current_count >= opt.min_readers && mr.current_count >= opt.min_readers) ||
+        Clock::now() >= wait_end) {
+      break;
+    }
+    if (wait_for_stop_signal(0.05) != 0) return false;
+  }
+  if (mi.current_count < opt.min_readers || mr.current_count < opt.min_readers) {
+    spdlog::warn(
+        "{} INS / {} rudder reader(s) matched within {:g} s (domain {}, {} wanted); publishing "
+        "anyway",
+        mi.current_count, mr.current_count, opt.wait_readers, domain, opt.min_readers);
+  }
+  return true;
+}
+
+/// The voyage's schedule. A deterministic stream, not a race with the wall clock: with
+/// RELIABLE writers the voyage waits for the readers' acknowledgements every kAckEvery samples,
+/// so no sample is ever overwritten before a slow reader has it; and when the process falls
+/// behind its schedule (a starved machine) it shifts the schedule instead of bursting to catch
+/// up. Both are counted and reported at the end.
+class Pacing {
+ public:
+  explicit Pacing(double speed) : speed_(speed), t0_(Clock::now()) {}
+
+  /// Sleeps until data time t is due, or shifts the schedule when more than kLate behind.
+  void wait_until_due(double t) {
+    const auto due = t0_ + wall_duration(t / speed_);
+    const auto now = Clock::now();
+    if (now > due + kLate) {
+      t0_ += now - due;
+      ++behind_;
+      behind_s_ += std::chrono::duration<double>(now - due).count();
+    } else {
+      std::this_thread::sleep_until(due);
+    }
+  }
+  /// Data time t is due now.
+  void restart_at(double t) { t0_ = Clock::now() - wall_duration(t / speed_); }
+  /// Waits (at most 10 s) until the readers have acknowledged everything written.
+  void flow_control(const Writers& w) {
+    const auto w0 = Clock::now();
+    const Duration_t bound(10.0);
+    const bool ok = w.ins->wait_for_acknowledgments(bound) == ReturnCode_t::RETCODE_OK &&
+                    w.rudder->wait_for_acknowledgments(bound) == ReturnCode_t::RETCODE_OK;
+    if (!ok) ++ack_waits_failed_;
+    ack_wait_max_ =
+        std::max(ack_wait_max_, std::chrono::duration<double>(Clock::now() - w0).count());
+  }
+  /// Whether the machine kept up: a test that fails can say if it was starved.
+  void log() const {
+    spdlog::info(
+        "pacing: fell behind the schedule {} time(s), {:.2f} s in all (shifted, not caught up); "
+        "longest wait for the readers' acknowledgements {:.3f} s, {} wait(s) timed out{}",
+        behind_, behind_s_, ack_wait_max_, ack_waits_failed_,
+        behind_ > 0 || ack_waits_failed_ > 0 ? " (a busy machine)" : "");
+  }
+
+ private:
+  static constexpr std::chrono::milliseconds kLate{250};
+  double speed_;
+  Clock::time_point t0_;
+  int behind_ = 0;             ///< times the schedule was shifted
+  double behind_s_ = 0.0;      ///< by how much in all [s of wall time]
+  int ack_waits_failed_ = 0;   ///< flow-control waits that timed out
+  double ack_wait_max_ = 0.0;  ///< the longest flow-control wait [s]
+};
+
+using Vessels = std::vector<std::pair<std::uint32_t, SimConfig>>;
+
+/// Writes one sample to DDS, counting failures in *failed (the first one logged).
+template <typename Sample>
+void write_counted(fdds::DataWriter* w, const Sample& s, std::uint64_t* failed) {
+  try {
+    dds::write(*w, s);
+  } catch (const std::exception& e) {
+    if ((*failed)++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
+  }
+}
+
+void write_rudder(const Writers& w, const Vessels& vessels, const std::vector<SimRow>& rows,
+                  std::uint64_t seq, std::uint64_t* failed) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const SimRow& r = rows[i];
+    fdi::RudderSample d;
+    d.mmsi(vessels[i].first);
+    d.seq(seq);
+    d.stamp(r.t);
+    d.delta(r.delta);
+    d.valid(std::isfinite(r.delta));
+    write_counted(w.rudder, d, failed);
+  }
+}
+
+void write_ins(const Writers& w, const Vessels& vessels, const std::vector<SimRow>& rows,
+               std::uint64_t seq, std::uint64_t* failed) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const SimRow& r = rows[i];
+    fdi::InsSample s;
+    s.mmsi(vessels[i].first);
+    s.seq(seq);
+    s.stamp(r.t);
+    // A missing value (stale fault) is sent as invalid; +Inf (invalid fault) as it is.
+    s.v(std::isnan(r.v) ? 0.0 : r.v);
+    s.r(std::isnan(r.r) ? 0.0 : r.r);
+    s.v_valid(!std::isnan(r.v));
+    s.r_valid(!std::isnan(r.r));
+    write_counted(w.ins, s, failed);
+  }
+}
+
+/// Handshake: the writers' match is one-sided; a reader acknowledges the first rudder sample
+/// only once it has matched this writer too. So the voyage starts when the matched sidecars
+/// listen (a rudder sample alone starts no INS timeout there). Bounded by what is left of
+/// --wait-readers, at least 1 s.
+void await_first_rudder_ack(const Writers& w, Clock::time_point wait_end) {
+  const double left = std::max(1.0, std::chrono::duration<double>(wait_end - Clock::now()).count());
+  if (w.rudder->wait_for_acknowledgments(Duration_t(left)) != ReturnCode_t::RETCODE_OK) {
+    spdlog::warn("the first rudder sample was not acknowledged within {:g} s", left);
+  }
+}
+
+/// What a voyage published.
+struct Published {
+  std::uint64_t seq = 0;     ///< samples per vessel
+  std::uint64_t failed = 0;  ///< writes that failed
+  bool stopped = false;      ///< by a signal
+};
+
+/// Publishes every simulation in lockstep, paced, until one ends or a stop signal comes.
+Published publish_voyage(const std::vector<std::unique_ptr<Simulator>>& sims,
+                         const Vessels& vessels, const Writers& w, const PublishOptions& opt,
+                         Clock::time_point wait_end) {
+  Pacing pacing(opt.speed);
+  Published out;
+  std::vector<SimRow> rows(sims.size());
+  for (bool more = true; more && !out.stopped;) {
+    for (std::size_t i = 0; i < sims.size() && more; ++i) more = sims[i]->next(&rows[i]);
+    if (!more) break;
+    const double t = rows.front().t;
+    pacing.wait_until_due(t);
+    const std::uint64_t seq = ++out.seq;
+    if (opt.reliable && seq > 1 && seq % kAckEvery == 0) pacing.flow_control(w);
+    // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp and
+    // releases it as soon as a rudder sample at or after that stamp has arrived.
+    write_rudder(w, vessels, rows, seq, &out.failed);
+    if (seq == 1 && opt.reliable) {
+      await_first_rudder_ack(w, wait_end);
+      pacing.restart_at(t);
+    }
+    write_ins(w, vessels, rows, seq, &out.failed);
+    if (seq % 1000 == 0) spdlog::debug("t = {:.2f} s", t);
+    out.stopped = wait_for_stop_signal(0.0) != 0;
+  }
+  spdlog::info("published {} samples per vessel{}{}", out.seq,
+               out.stopped ? " (stopped by a signal)" : "",
+               out.failed ? ", " + std::to_string(out.failed) + " writes failed" : std::string());
+  pacing.log();
+  return out;
+}
+
+/// Reliable writers: let the readers acknowledge the tail; then linger (bounded).
+void linger(const Writers& w, const PublishOptions& opt) {
+  const Duration_t linger(opt.linger);
+  if (opt.reliable) {
+    w.ins->wait_for_acknowledgments(linger);
+    w.rudder->wait_for_acknowledgments(linger);
+  }
+  (void)wait_for_stop_signal(opt.linger);
+}
+
+}  // namespace
+
+int publish_simulation(const Vessels& vessels, const dds::DdsConfig& cfg,
+                       const PublishOptions& opt) {
   block_stop_signals();  // before Fast DDS starts its threads
   route_fastdds_log_to_spdlog();
   if (vessels.empty()) return kExitUsage;
@@ -37,149 +250,15 @@ int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& v
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
-  eprosima::fastdds::dds::DataWriter* ins = nullptr;
-  eprosima::fastdds::dds::DataWriter* rud = nullptr;
-  try {
-    ins =
-        &ctx->create_writer(dds::TopicId::kIns, opt.reliable ? dds::profiles::kInsWriterReliable
-                                                             : dds::profiles::kInsWriterBestEffort);
-    rud = &ctx->create_writer(dds::TopicId::kRudder, opt.reliable
-                                                         ? dds::profiles::kRudderWriterReliable
-                                                         : dds::profiles::kRudderWriterBestEffort);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return kExitFailure;
-  }
-  // Bounded wait for the sidecars, so that the first seconds of the voyage are not lost.
-  const auto wait_end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(opt.wait_readers));
-  eprosima::fastdds::dds::PublicationMatchedStatus mi, mr;
-  for (;;) {
-    ins->get_publication_matched_status(mi);
-    rud->get_publication_matched_status(mr);
-    if ((mi.current_count >= opt.min_readers && mr.current_count >= opt.min_readers) ||
-        Clock::now() >= wait_end) {
-      break;
-    }
-    if (wait_for_stop_signal(0.05) != 0) return kExitOk;
-  }
-  if (mi.current_count < opt.min_readers || mr.current_count < opt.min_readers) {
-    spdlog::warn(
-        "{} INS / {} rudder reader(s) matched within {:g} s (domain {}, {} wanted); publishing "
-        "anyway",
-        mi.current_count, mr.current_count, opt.wait_readers, cfg.domain_id, opt.min_readers);
-  }
+  Writers w;
+  if (!create_writers(*ctx, opt.reliable, &w)) return kExitFailure;
+  const auto wait_end = Clock::now() + wall_duration(opt.wait_readers);
+  if (!wait_for_readers(w, opt, cfg.domain_id, wait_end)) return kExitOk;
   spdlog::info("publishing {} vessel(s) at {:g} Hz, {:g}x real time, {} writers", vessels.size(),
                vessels.front().second.rate_hz, opt.speed,
                opt.reliable ? "RELIABLE" : "BEST_EFFORT");
-  auto t0 = Clock::now();
-  std::uint64_t seq = 0, failed = 0;
-  // A deterministic stream, not a race with the wall clock: with RELIABLE writers the voyage
-  // waits for the readers' acknowledgements every kAckEvery samples (half the writers' 256-deep
-  // history), so no sample is ever overwritten before a slow reader has it; and when the process
-  // falls behind its schedule (a starved machine) it shifts the schedule instead of bursting to
-  // catch up. Both are counted and reported at the end.
-  constexpr std::uint64_t kAckEvery = 128;
-  const auto kLate = std::chrono::milliseconds(250);
-  int behind = 0;             // times the schedule was shifted
-  double behind_s = 0.0;      // by how much in all [s of wall time]
-  int ack_waits_failed = 0;   // flow-control waits that timed out
-  double ack_wait_max = 0.0;  // the longest flow-control wait [s]
-  std::vector<SimRow> rows(sims.size());
-  bool stopped = false;
-  for (bool more = true; more && !stopped;) {
-    for (std::size_t i = 0; i < sims.size() && more; ++i) more = sims[i]->next(&rows[i]);
-    if (!more) break;
-    const double t = rows.front().t;
-    const auto due = t0 + std::chrono::duration_cast<Clock::duration>(
-                              std::chrono::duration<double>(t / opt.speed));
-    const auto now = Clock::now();
-    if (now > due + kLate) {
-      t0 += now - due;
-      ++behind;
-      behind_s += std::chrono::duration<double>(now - due).count();
-    } else {
-      std::this_thread::sleep_until(due);
-    }
-    ++seq;
-    if (opt.reliable && seq > 1 && seq % kAckEvery == 0) {
-      const auto w0 = Clock::now();
-      const eprosima::fastrtps::Duration_t bound(10.0);
-      const bool ok = ins->wait_for_acknowledgments(bound) ==
-                          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK &&
-                      rud->wait_for_acknowledgments(bound) ==
-                          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
-      if (!ok) ++ack_waits_failed;
-      ack_wait_max =
-          std::max(ack_wait_max, std::chrono::duration<double>(Clock::now() - w0).count());
-    }
-    // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp and
-    // releases it as soon as a rudder sample at or after that stamp has arrived.
-    for (std::size_t i = 0; i < sims.size(); ++i) {
-      const SimRow& r = rows[i];
-      fdi::RudderSample d;
-      d.mmsi(vessels[i].first);
-      d.seq(seq);
-      d.stamp(r.t);
-      d.delta(r.delta);
-      d.valid(std::isfinite(r.delta));
-      try {
-        dds::write(*rud, d);
-      } catch (const std::exception& e) {
-        if (failed++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
-      }
-    }
-    if (seq == 1 && opt.reliable) {
-      // Handshake: the writers' match above is one-sided; a reader acknowledges the first
-      // rudder sample only once it has matched this writer too. So the voyage starts when the
-      // matched sidecars listen (a rudder sample alone starts no INS timeout there). Bounded
-      // by what is left of --wait-readers, at least 1 s.
-      const double left =
-          std::max(1.0, std::chrono::duration<double>(wait_end - Clock::now()).count());
-      if (rud->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(left)) !=
-          eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
-        spdlog::warn("the first rudder sample was not acknowledged within {:g} s", left);
-      }
-      t0 = Clock::now() - std::chrono::duration_cast<Clock::duration>(
-                              std::chrono::duration<double>(t / opt.speed));
-    }
-    for (std::size_t i = 0; i < sims.size(); ++i) {
-      const SimRow& r = rows[i];
-      fdi::InsSample s;
-      s.mmsi(vessels[i].first);
-      s.seq(seq);
-      s.stamp(r.t);
-      // A missing value (stale fault) is sent as invalid; +Inf (invalid fault) as it is.
-      s.v(std::isnan(r.v) ? 0.0 : r.v);
-      s.r(std::isnan(r.r) ? 0.0 : r.r);
-      s.v_valid(!std::isnan(r.v));
-      s.r_valid(!std::isnan(r.r));
-      try {
-        dds::write(*ins, s);
-      } catch (const std::exception& e) {
-        if (failed++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
-      }
-    }
-    if (seq % 1000 == 0) spdlog::debug("t = {:.2f} s", t);
-    stopped = wait_for_stop_signal(0.0) != 0;
-  }
-  spdlog::info("published {} samples per vessel{}{}", seq, stopped ? " (stopped by a signal)" : "",
-               failed ? ", " + std::to_string(failed) + " writes failed" : std::string());
-  // Whether the machine kept up: a test that fails can say if it was starved.
-  spdlog::info(
-      "pacing: fell behind the schedule {} time(s), {:.2f} s in all (shifted, not caught up); "
-      "longest wait for the readers' acknowledgements {:.3f} s, {} wait(s) timed out{}",
-      behind, behind_s, ack_wait_max, ack_waits_failed,
-      behind > 0 || ack_waits_failed > 0 ? " (a busy machine)" : "");
-  if (!stopped) {
-    // Reliable writers: let the readers acknowledge the tail; then linger (bounded).
-    const eprosima::fastrtps::Duration_t linger(opt.linger);
-    if (opt.reliable) {
-      ins->wait_for_acknowledgments(linger);
-      rud->wait_for_acknowledgments(linger);
-    }
-    (void)wait_for_stop_signal(opt.linger);
-  }
+  const Published p = publish_voyage(sims, vessels, w, opt, wait_end);
+  if (!p.stopped) linger(w, opt);
   return kExitOk;
 }
 

@@ -22,6 +22,6 @@ struct PublishOptions {
 /// to real time x speed, until the duration ends or SIGINT/SIGTERM (blocked beforehand).
 /// Returns a process exit code.
 int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,
-                       const usv_fdi::dds::DdsConfig& dds, const PublishOptions& opt);
+                       const usvfdi::dds::DdsConfig& dds, const PublishOptions& opt);
 
 }  // namespace usvfdi::app

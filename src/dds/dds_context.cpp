@@ -13,14 +13,14 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/dds/topic/qos/TopicQos.hpp>
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
 
 [[noreturn]] void fail(const std::string& what) {
-  throw std::runtime_error("usv_fdi::dds: " + what);
+  throw std::runtime_error("usvfdi::dds: " + what);
 }
 
 template <class PubSubType>
@@ -223,4 +223,4 @@ void DdsContext::delete_reader(fdds::DataReader& reader) {
   }
 }
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

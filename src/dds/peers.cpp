@@ -8,7 +8,7 @@
 #include <cctype>
 #include <cstdint>
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 
 namespace rtps = eprosima::fastrtps::rtps;
 
@@ -123,4 +123,4 @@ std::uint32_t vessel_of_writer(const std::vector<std::string>& partitions) {
   return partitions.size() == 1 ? vessel_of_partition(partitions.front()) : 0;
 }
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

@@ -14,7 +14,7 @@
 #include <fastrtps/types/TypesBase.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 namespace {
 
 using eprosima::fastdds::dds::DomainParticipantFactory;
@@ -35,8 +35,7 @@ std::set<std::string>& loaded_files() {
 DomainParticipantFactory& factory() {
   DomainParticipantFactory* f = DomainParticipantFactory::get_instance();
   if (f == nullptr) {
-    throw std::runtime_error(
-        "usv_fdi::dds: DomainParticipantFactory::get_instance() returned null");
+    throw std::runtime_error("usvfdi::dds: DomainParticipantFactory::get_instance() returned null");
   }
   return *f;
 }
@@ -45,7 +44,7 @@ void load_default_profiles_locked() {
   // Loads FASTRTPS_DEFAULT_PROFILES_FILE (or ./DEFAULT_FASTRTPS_PROFILES.xml) once per process.
   if (factory().load_profiles() != ReturnCode_t::RETCODE_OK) {
     throw std::runtime_error(
-        "usv_fdi::dds: loading the default Fast DDS profiles failed "
+        "usvfdi::dds: loading the default Fast DDS profiles failed "
         "(FASTRTPS_DEFAULT_PROFILES_FILE / DEFAULT_FASTRTPS_PROFILES.xml)");
   }
 }
@@ -59,7 +58,7 @@ void load_default_profiles() {
 
 void load_profiles_file(const std::string& path) {
   if (path.empty()) {
-    throw std::invalid_argument("usv_fdi::dds: empty XML profiles file path");
+    throw std::invalid_argument("usvfdi::dds: empty XML profiles file path");
   }
   std::lock_guard<std::mutex> lock(registry_mutex());
   load_default_profiles_locked();
@@ -75,15 +74,15 @@ void load_profiles_file(const std::string& path) {
   }
   if (fd >= 0) ::close(fd);
   if (err != 0) {
-    throw std::runtime_error("usv_fdi::dds: cannot read the XML profiles file '" + path +
+    throw std::runtime_error("usvfdi::dds: cannot read the XML profiles file '" + path +
                              "': " + std::strerror(err));
   }
   if (factory().load_XML_profiles_file(path) != ReturnCode_t::RETCODE_OK) {
-    throw std::runtime_error("usv_fdi::dds: Fast DDS rejected the XML profiles file '" + path +
+    throw std::runtime_error("usvfdi::dds: Fast DDS rejected the XML profiles file '" + path +
                              "' (malformed or duplicate profile names; see the Fast DDS error "
                              "log)");
   }
   loaded_files().insert(path);
 }
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

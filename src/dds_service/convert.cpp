@@ -4,25 +4,28 @@
 
 #include <string>
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 
 // The pipeline's flag values are the IDL's constants (FdiStatus carries them as they are).
-static_assert(kInputInsSilent == fdi::INPUT_INS_SILENT &&
-                  kInputRudderMissing == fdi::INPUT_RUDDER_MISSING &&
-                  kInputAccelUnusable == fdi::INPUT_ACCELEROMETER_UNUSABLE &&
-                  kInputGyroUnusable == fdi::INPUT_GYRO_UNUSABLE &&
-                  kInputBadTimestamps == fdi::INPUT_BAD_TIMESTAMPS &&
-                  kInputInvalidValues == fdi::INPUT_INVALID_VALUES &&
-                  kInputGaps == fdi::INPUT_GAPS && kInputReordered == fdi::INPUT_REORDERED &&
-                  kInputQueueDrops == fdi::INPUT_QUEUE_DROPS &&
-                  kInputSamplesLost == fdi::INPUT_SAMPLES_LOST &&
-                  kInputOtherEventWriter == fdi::INPUT_OTHER_EVENT_WRITER,
+static_assert(pipeline::kInputInsSilent == fdi::INPUT_INS_SILENT &&
+                  pipeline::kInputRudderMissing == fdi::INPUT_RUDDER_MISSING &&
+                  pipeline::kInputAccelUnusable == fdi::INPUT_ACCELEROMETER_UNUSABLE &&
+                  pipeline::kInputGyroUnusable == fdi::INPUT_GYRO_UNUSABLE &&
+                  pipeline::kInputBadTimestamps == fdi::INPUT_BAD_TIMESTAMPS &&
+                  pipeline::kInputInvalidValues == fdi::INPUT_INVALID_VALUES &&
+                  pipeline::kInputGaps == fdi::INPUT_GAPS &&
+                  pipeline::kInputReordered == fdi::INPUT_REORDERED &&
+                  pipeline::kInputQueueDrops == fdi::INPUT_QUEUE_DROPS &&
+                  pipeline::kInputSamplesLost == fdi::INPUT_SAMPLES_LOST &&
+                  pipeline::kInputOtherEventWriter == fdi::INPUT_OTHER_EVENT_WRITER,
               "InputFlag differs from idl/usv_fdi.idl INPUT_*");
-static_assert(kPauseNotArmed == fdi::PAUSE_NOT_ARMED && kPauseLearning == fdi::PAUSE_LEARNING &&
-                  kPauseRudderMissing == fdi::PAUSE_RUDDER_MISSING &&
-                  kPauseInsUnusable == fdi::PAUSE_INS_UNUSABLE &&
-                  kPauseInsSilent == fdi::PAUSE_INS_SILENT && kPauseFault == fdi::PAUSE_FAULT &&
-                  kPauseObserver == fdi::PAUSE_OBSERVER,
+static_assert(pipeline::kPauseNotArmed == fdi::PAUSE_NOT_ARMED &&
+                  pipeline::kPauseLearning == fdi::PAUSE_LEARNING &&
+                  pipeline::kPauseRudderMissing == fdi::PAUSE_RUDDER_MISSING &&
+                  pipeline::kPauseInsUnusable == fdi::PAUSE_INS_UNUSABLE &&
+                  pipeline::kPauseInsSilent == fdi::PAUSE_INS_SILENT &&
+                  pipeline::kPauseFault == fdi::PAUSE_FAULT &&
+                  pipeline::kPauseObserver == fdi::PAUSE_OBSERVER,
               "PauseReason differs from idl/usv_fdi.idl PAUSE_*");
 
 fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {
@@ -70,7 +73,8 @@ bool from_dds(const fdi::FaultEvent& d, FaultEvent* out) {
   return true;
 }
 
-fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const IsolationParams& p) {
+fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
+                      const IsolationParams& p) {
   fdi::FdiStatus d;
   d.mmsi(mmsi);
   d.stamp(s.stamp);
@@ -123,7 +127,7 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   } else {
     msg += "armed; ";
   }
-  if (s.identification_paused & kPauseFault) msg += "identification frozen (fault); ";
+  if (s.identification_paused & pipeline::kPauseFault) msg += "identification frozen (fault); ";
   if (s.rejected > 0) msg += std::to_string(s.rejected) + " samples rejected; ";
   if (s.lost_ins + s.lost_rudder > 0)
     msg += std::to_string(s.lost_ins + s.lost_rudder) + " samples lost; ";
@@ -131,16 +135,16 @@ fdi::FdiStatus to_dds(const PipelineStatus& s, std::uint32_t mmsi, const Isolati
   return d;
 }
 
-InsInput from_dds(const fdi::InsSample& s) {
-  return InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid(), s.seq()};
+pipeline::InsInput from_dds(const fdi::InsSample& s) {
+  return pipeline::InsInput{s.stamp(), s.v(), s.r(), s.v_valid(), s.r_valid(), s.seq()};
 }
 
-RudderInput from_dds(const fdi::RudderSample& s) {
-  return RudderInput{s.stamp(), s.delta(), s.valid(), s.seq()};
+pipeline::RudderInput from_dds(const fdi::RudderSample& s) {
+  return pipeline::RudderInput{s.stamp(), s.delta(), s.valid(), s.seq()};
 }
 
-AckInput from_dds(const fdi::FaultAck& a) {
-  AckInput out;
+pipeline::AckInput from_dds(const fdi::FaultAck& a) {
+  pipeline::AckInput out;
   out.sensor = static_cast<Sensor>(a.sensor());
   out.sequence = a.sequence();
   out.who = escape_text(a.operator_id().to_string());  // a peer's text: never raw
@@ -148,4 +152,4 @@ AckInput from_dds(const fdi::FaultAck& a) {
   return out;
 }
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

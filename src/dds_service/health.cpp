@@ -15,7 +15,7 @@
 
 #include "usv_fdi/io/jsonl.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 namespace {
 
 std::string num(double x) {
@@ -62,12 +62,12 @@ std::string health_json(const HealthReport& r) {
      << ", \"ins_age\": " << (r.live.ins_age < 0 ? "null" : num(r.live.ins_age))
      << ", \"rudder_age\": " << (r.live.rudder_age < 0 ? "null" : num(r.live.rudder_age))
      << ", \"samples\": " << r.samples << ", \"converged\": " << (r.converged ? "true" : "false")
-     << ", \"armed\": " << (r.armed ? "true" : "false")
-     << ", \"input_flags\": " << io::json_string_array(input_flag_names(r.input_flags), ", ")
+     << ", \"armed\": " << (r.armed ? "true" : "false") << ", \"input_flags\": "
+     << io::json_string_array(pipeline::input_flag_names(r.input_flags), ", ")
      << ", \"identification_paused\": "
-     << io::json_string_array(pause_reason_names(r.identification_paused), ", ")
+     << io::json_string_array(pipeline::pause_reason_names(r.identification_paused), ", ")
      << ", \"isolation_paused\": "
-     << io::json_string_array(pause_reason_names(r.isolation_paused), ", ")
+     << io::json_string_array(pipeline::pause_reason_names(r.isolation_paused), ", ")
      << ", \"dropped\": " << r.dropped << ", \"fault_event_readers\": " << r.fault_event_readers
      << ", \"state_file\": " << io::json_string(r.state_file)
      << ", \"state_error\": " << io::json_string(r.state_error) << "}\n";
@@ -177,4 +177,4 @@ HealthVerdict check_health_file(const std::string& path, double max_age, double 
   return v;
 }
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

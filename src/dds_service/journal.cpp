@@ -16,7 +16,7 @@
 
 #include "usv_fdi/io/jsonl.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 namespace {
 
 constexpr const char* kFormat = "usv-fdi fault state";
@@ -348,4 +348,4 @@ std::uint64_t StateJournal::saves() const {
   return saves_;
 }
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

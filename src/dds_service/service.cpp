@@ -22,9 +22,8 @@
 #include "usv_fdi/core/text.hpp"
 #include "usv_fdi/dds_service/convert.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 
-namespace dds = usv_fdi::dds;
 using eprosima::fastdds::dds::DataReader;
 using eprosima::fastdds::dds::DataReaderListener;
 using eprosima::fastdds::dds::StatusMask;
@@ -37,7 +36,7 @@ using eprosima::fastrtps::types::ReturnCode_t;
 class FdiService::Listener : public DataReaderListener {
  public:
   /// `peers`: the participant's directory when it runs DDS Security (nullptr: it does not).
-  Listener(FdiPipeline* p, std::uint32_t mmsi, const dds::PeerDirectory* peers)
+  Listener(pipeline::FdiPipeline* p, std::uint32_t mmsi, const dds::PeerDirectory* peers)
       : p_(p), mmsi_(mmsi), peers_(peers) {}
   void on_data_available(DataReader* reader) override {
     using Info = eprosima::fastdds::dds::SampleInfo;
@@ -51,7 +50,7 @@ class FdiService::Listener : public DataReaderListener {
       });
     } else if (reader == ack_) {
       drain<fdi::FaultAck>(*reader, [this](const fdi::FaultAck& a, const Info& info) {
-        AckInput in = from_dds(a);
+        pipeline::AckInput in = from_dds(a);
         // Under DDS Security the operator is the writer's authenticated identity, not what the
         // sample claims.
         if (peers_ != nullptr) {
@@ -83,7 +82,7 @@ class FdiService::Listener : public DataReaderListener {
     }
   }
 
-  FdiPipeline* p_;
+  pipeline::FdiPipeline* p_;
   std::uint32_t mmsi_;
   const dds::PeerDirectory* peers_;
 };
@@ -193,11 +192,11 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
       log_(1, std::string(head) + ": " + e.message);
     }
   };
-  auto on_status = [this, mmsi, iso](const PipelineStatus& s) {
+  auto on_status = [this, mmsi, iso](const pipeline::PipelineStatus& s) {
     fdi::FdiStatus d = to_dds(s, mmsi, iso);
     if (watch_) {
       if (watch_->recent(std::chrono::seconds(10))) {
-        d.input_flags(d.input_flags() | kInputOtherEventWriter);
+        d.input_flags(d.input_flags() | pipeline::kInputOtherEventWriter);
       }
       d.other_event_writers(watch_->writers());
     }
@@ -205,7 +204,7 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   };
   // This run's incarnation: its start time (microseconds since the Unix epoch), above that
   // of every restored event even if the clock went back.
-  PipelineOptions popt = cfg_.pipeline;
+  pipeline::PipelineOptions popt = cfg_.pipeline;
   if (popt.incarnation == 0) {
     std::uint64_t floor = 0;
     for (const FaultEvent& e : restored_) floor = std::max(floor, e.incarnation);
@@ -215,7 +214,7 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
                                        .count());
     popt.incarnation = std::max(now_us, floor + 1);
   }
-  pipeline_ = std::make_unique<FdiPipeline>(cfg_.engine, popt, on_event, on_status, log_);
+  pipeline_ = std::make_unique<pipeline::FdiPipeline>(cfg_.engine, popt, on_event, on_status, log_);
   for (const FaultEvent& e : restored_) pipeline_->restore(e);
   listener_ =
       std::make_unique<Listener>(pipeline_.get(), mmsi, dds_->secure() ? &dds_->peers() : nullptr);
@@ -419,4 +418,4 @@ void FdiService::stop() {
   dds_.reset();  // delete_contained_entities(), then the participant
 }
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

@@ -15,7 +15,7 @@
 #include "io/json_lite.hpp"
 #include "test_env.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 namespace js = usvfdi::testing_json;
@@ -180,4 +180,4 @@ std::optional<int> Fleet::run_to_end(const std::string& name, std::vector<std::s
   return p.wait_exit(std::chrono::milliseconds(2000));
 }
 
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

@@ -13,12 +13,12 @@
 #include "monitor_json.hpp"
 #include "process.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 
 /// The monitor's JSON Lines, as the one model of the test-support library (monitor_json.hpp).
-using MonitorEvent = usv_fdi::test_support::MonitorFault;
-using MonitorStatus = usv_fdi::test_support::MonitorStatusLine;
-using MonitorVessel = usv_fdi::test_support::MonitorVesselChange;
+using MonitorEvent = usvfdi::test_support::MonitorFault;
+using MonitorStatus = usvfdi::test_support::MonitorStatusLine;
+using MonitorVessel = usvfdi::test_support::MonitorVesselChange;
 
 /// Parses monitor --json lines (others are ignored); returns false on a malformed JSON line.
 bool parse_monitor_line(const std::string& line, std::vector<MonitorEvent>* events,
@@ -95,4 +95,4 @@ bool read_monitor_until(ChildProcess& monitor, std::vector<MonitorEvent>* events
   return true;
 }
 
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

@@ -10,7 +10,7 @@
 
 #include "io/json_lite.hpp"
 
-namespace usv_fdi::test_support {
+namespace usvfdi::test_support {
 
 /// {"type":"fault"}: one FaultEvent update.
 struct MonitorFault {
@@ -145,4 +145,4 @@ inline MonitorLine parse_monitor_json(const std::string& line, double received =
   return out;
 }
 
-}  // namespace usv_fdi::test_support
+}  // namespace usvfdi::test_support

@@ -80,15 +80,15 @@
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using usv_fdi::dds::DdsConfig;
-using usv_fdi::dds::DdsContext;
-namespace profiles = usv_fdi::dds::profiles;
+using usvfdi::dds::DdsConfig;
+using usvfdi::dds::DdsContext;
+namespace profiles = usvfdi::dds::profiles;
 using Clock = std::chrono::steady_clock;
-using usv_fdi::test_support::probe::deadline_after;
-using usv_fdi::test_support::probe::g_stop;
-using usv_fdi::test_support::probe::install_signal_handlers;
-using usv_fdi::test_support::probe::parse_unsigned;
-using usv_fdi::test_support::probe::UsageError;
+using usvfdi::test_support::probe::deadline_after;
+using usvfdi::test_support::probe::g_stop;
+using usvfdi::test_support::probe::install_signal_handlers;
+using usvfdi::test_support::probe::parse_unsigned;
+using usvfdi::test_support::probe::UsageError;
 
 struct Options {
   std::string mode;
@@ -210,13 +210,13 @@ int publish_faults(const Options& o) {
       if (o.sensor && s != *o.sensor) continue;
       fdi::FaultEvent e = make_event(o.mmsi_base + v, s, o.state, o.sequence);
       if (o.message) e.message(*o.message);
-      usv_fdi::dds::write(writer, e);
+      usvfdi::dds::write(writer, e);
       ++writes;
       ++instances;
     }
   }
   if (o.rewrite_state) {
-    usv_fdi::dds::write(writer, make_event(o.mmsi_base, 0, *o.rewrite_state, o.sequence + 1));
+    usvfdi::dds::write(writer, make_event(o.mmsi_base, 0, *o.rewrite_state, o.sequence + 1));
     ++writes;
   }
   std::printf("published instances=%u writes=%u\n", instances, writes);
@@ -255,7 +255,7 @@ int read_faults(const Options& o) {
     fdds::ConditionSeq active;
     (void)waitset.wait(active, eprosima::fastrtps::Duration_t(0, 100000000));
     batch.clear();
-    usv_fdi::dds::take_all(reader, batch);
+    usvfdi::dds::take_all(reader, batch);
     for (const auto& e : batch) {
       Seen& s = seen[{e.mmsi(), static_cast<unsigned>(e.sensor())}];
       if (s.samples == 0 || e.sequence() >= s.latest.sequence()) s.latest = e;
@@ -328,7 +328,7 @@ int publish_inputs(const Options& o) {
     s.r(r);
     s.v_valid(vv);
     s.r_valid(rv);
-    usv_fdi::dds::write(ins, s);
+    usvfdi::dds::write(ins, s);
   };
   const auto write_rudder = [&](double t, double d, bool valid) {
     fdi::RudderSample s;
@@ -337,7 +337,7 @@ int publish_inputs(const Options& o) {
     s.stamp(t);
     s.delta(d);
     s.valid(valid);
-    usv_fdi::dds::write(rudder, s);
+    usvfdi::dds::write(rudder, s);
   };
   for (std::size_t i = 0; i < lines.size() && !g_stop.load(); ++i) {
     const auto& w = lines[i];
@@ -426,9 +426,9 @@ int slow_reader(const Options& o) {
   q.resource_limits().max_samples_per_instance = 2;
   q.resource_limits().allocated_samples = 8;
   fdds::DataReader* events = ctx.subscriber().create_datareader(
-      &ctx.topic(usv_fdi::dds::TopicId::kFaultEvent), q, &listener);
+      &ctx.topic(usvfdi::dds::TopicId::kFaultEvent), q, &listener);
   fdds::DataReader* status =
-      ctx.subscriber().create_datareader(&ctx.topic(usv_fdi::dds::TopicId::kStatus), q, &listener);
+      ctx.subscriber().create_datareader(&ctx.topic(usvfdi::dds::TopicId::kStatus), q, &listener);
   if (events == nullptr || status == nullptr) {
     std::fprintf(stderr, "slow-reader: cannot create the readers\n");
     return 4;

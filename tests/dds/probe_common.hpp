@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace usv_fdi::test_support::probe {
+namespace usvfdi::test_support::probe {
 
 using Clock = std::chrono::steady_clock;
 
@@ -51,4 +51,4 @@ inline Clock::time_point deadline_after(double seconds) {
          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-}  // namespace usv_fdi::test_support::probe
+}  // namespace usvfdi::test_support::probe

@@ -14,7 +14,7 @@
 
 extern char** environ;
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -152,4 +152,4 @@ std::optional<int> ChildProcess::wait_exit(std::chrono::milliseconds timeout) {
   return exit_code_;
 }
 
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

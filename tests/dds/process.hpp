@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 
 class ChildProcess {
  public:
@@ -48,4 +48,4 @@ class ChildProcess {
   std::optional<int> exit_code_;
 };
 
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

@@ -13,7 +13,7 @@
 #include <string>
 #include <thread>
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 
 class StarvationMeter {
  public:
@@ -71,4 +71,4 @@ class StarvationMeter {
   std::thread thread_;
 };
 
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 
 inline constexpr const char* kProfilesFile = USV_FDI_DDS_PROFILES;
 inline constexpr const char* kProbe = USV_FDI_DDS_PROBE;
@@ -22,4 +22,4 @@ inline std::string unique_partition() {
   return "usv_fdi_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++);
 }
 
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

@@ -13,7 +13,7 @@
 
 #include "fleet.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 using std::chrono::milliseconds;
@@ -139,4 +139,4 @@ TEST(ForgedEvents, AForgedAllClearDoesNotHideARaisedAlarmOnARunningMonitor) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

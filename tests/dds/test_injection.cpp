@@ -10,7 +10,7 @@
 
 #include "fleet.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 using std::chrono::seconds;
@@ -86,4 +86,4 @@ TEST(Injection, EscapeCodesInAFaultMessageDoNotReachTheTerminal) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

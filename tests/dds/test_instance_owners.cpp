@@ -107,16 +107,16 @@ TEST(InstanceOwners, AnOwnerThatComesBackKeepsItsInstances) {
 }
 
 TEST(PeerHelpers, CommonNameOfBothSubjectForms) {
-  EXPECT_EQ(usv_fdi::dds::common_name("/C=NO/O=usv-fdi test fleet/OU=shore/CN=shore2"), "shore2");
-  EXPECT_EQ(usv_fdi::dds::common_name("CN=shore,OU=shore,O=usv-fdi test fleet,C=NO"), "shore");
-  EXPECT_EQ(usv_fdi::dds::common_name("CN=a\\,b,O=x"), "a,b");
-  EXPECT_EQ(usv_fdi::dds::common_name("/C=NO/O=x"), "");
-  EXPECT_EQ(usv_fdi::dds::common_name(""), "");
+  EXPECT_EQ(usvfdi::dds::common_name("/C=NO/O=usv-fdi test fleet/OU=shore/CN=shore2"), "shore2");
+  EXPECT_EQ(usvfdi::dds::common_name("CN=shore,OU=shore,O=usv-fdi test fleet,C=NO"), "shore");
+  EXPECT_EQ(usvfdi::dds::common_name("CN=a\\,b,O=x"), "a,b");
+  EXPECT_EQ(usvfdi::dds::common_name("/C=NO/O=x"), "");
+  EXPECT_EQ(usvfdi::dds::common_name(""), "");
 }
 
 TEST(PeerHelpers, TheVesselOfAPartitionAndOfAWriter) {
-  using usv_fdi::dds::vessel_of_partition;
-  using usv_fdi::dds::vessel_of_writer;
+  using usvfdi::dds::vessel_of_partition;
+  using usvfdi::dds::vessel_of_writer;
   EXPECT_EQ(vessel_of_partition("vessel-257000001"), 257000001u);
   EXPECT_EQ(vessel_of_partition("test_12_vessel-257000002"), 257000002u);
   EXPECT_EQ(vessel_of_partition("vessel-*"), 0u);
@@ -129,7 +129,7 @@ TEST(PeerHelpers, TheVesselOfAPartitionAndOfAWriter) {
 }
 
 TEST(PeerHelpers, TheOperatorOfAnAckIsTheAuthenticatedIdentity) {
-  using usv_fdi::dds::operator_of;
+  using usvfdi::dds::operator_of;
   EXPECT_EQ(operator_of("/C=NO/OU=shore/CN=shore", "alice"), "shore:alice");
   EXPECT_EQ(operator_of("/C=NO/OU=shore/CN=shore", "shore"), "shore");
   EXPECT_EQ(operator_of("/C=NO/OU=shore/CN=shore", ""), "shore");

@@ -19,7 +19,7 @@
 #include "test_env.hpp"
 #include "usv_fdi/dds/profiles.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 using std::chrono::milliseconds;
@@ -170,9 +170,9 @@ TEST(LateJoinerTest, PublisherExitsOnSigint) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 // A deployment overrides any shipped QoS profile through FASTRTPS_DEFAULT_PROFILES_FILE,
@@ -222,4 +222,4 @@ TEST(XmlProfiles, DefaultProfilesFileOverridesAShippedProfile) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

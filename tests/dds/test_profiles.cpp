@@ -23,7 +23,7 @@
 #include "test_env.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
@@ -328,4 +328,4 @@ TEST(DdsContext, InProcessStatusRoundTrip) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

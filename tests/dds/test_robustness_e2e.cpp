@@ -33,7 +33,7 @@
 #include "fleet.hpp"
 #include "test_env.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -891,4 +891,4 @@ TEST(BadConfig, MistakesNameTheFileKeyAndValue) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

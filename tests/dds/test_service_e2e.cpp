@@ -24,7 +24,7 @@
 #include "starvation.hpp"
 #include "test_env.hpp"
 
-namespace usv_fdi::dds::test {
+namespace usvfdi::dds::test {
 namespace {
 
 using std::chrono::milliseconds;
@@ -612,4 +612,4 @@ TEST(ServiceCli, BadConfigurationsAreRefusedWithTheirReason) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::dds::test
+}  // namespace usvfdi::dds::test

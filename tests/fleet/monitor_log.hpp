@@ -12,13 +12,13 @@
 #include "monitor_json.hpp"
 #include "process.hpp"
 
-namespace usv_fdi::fleet::test {
+namespace usvfdi::fleet::test {
 
 /// The monitor's JSON Lines, as the one model of the test-support library (monitor_json.hpp).
-using FaultUpdate = usv_fdi::test_support::MonitorFault;
-using StatusUpdate = usv_fdi::test_support::MonitorStatusLine;
-using VesselChange = usv_fdi::test_support::MonitorVesselChange;
-using ConflictReport = usv_fdi::test_support::MonitorConflict;
+using FaultUpdate = usvfdi::test_support::MonitorFault;
+using StatusUpdate = usvfdi::test_support::MonitorStatusLine;
+using VesselChange = usvfdi::test_support::MonitorVesselChange;
+using ConflictReport = usvfdi::test_support::MonitorConflict;
 
 /// Everything a monitor printed, in order.
 struct MonitorLog {
@@ -34,8 +34,8 @@ struct MonitorLog {
       if (!line.empty()) other.push_back(line);
       return;
     }
-    const usv_fdi::test_support::MonitorLine l =
-        usv_fdi::test_support::parse_monitor_json(line, received);
+    const usvfdi::test_support::MonitorLine l =
+        usvfdi::test_support::parse_monitor_json(line, received);
     if (l.type == "fault") {
       faults.push_back(l.fault);
     } else if (l.type == "status") {
@@ -144,4 +144,4 @@ inline long long number_before(const std::string& text, const std::string& suffi
   return std::stoll(text.substr(begin, at - begin));
 }
 
-}  // namespace usv_fdi::fleet::test
+}  // namespace usvfdi::fleet::test

@@ -4,7 +4,7 @@
 // again when the object goes away, including the processes still running in them. Header-only;
 // needs USV_FDI_NETNS_SCRIPT (the path of netns.sh) defined by the build.
 //
-//   usv_fdi::fleet::test::NetnsFleet fleet("ft", 5);
+//   usvfdi::fleet::test::NetnsFleet fleet("ft", 5);
 //   if (!fleet.available()) GTEST_SKIP() << fleet.skip_reason();
 //   ChildProcess sidecar(fleet.in("v1", {usv_fdi_exe, "run", ...}));
 //   fleet.addr("shore");        // "10.77.0.1"
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace usv_fdi::fleet::test {
+namespace usvfdi::fleet::test {
 
 class NetnsFleet {
  public:
@@ -121,4 +121,4 @@ class NetnsFleet {
   std::string skip_reason_;
 };
 
-}  // namespace usv_fdi::fleet::test
+}  // namespace usvfdi::fleet::test

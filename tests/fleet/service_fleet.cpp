@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <thread>
 
-namespace usv_fdi::fleet::test {
+namespace usvfdi::fleet::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -239,4 +239,4 @@ std::string ServiceFleet::logs_tail() const {
   return s;
 }
 
-}  // namespace usv_fdi::fleet::test
+}  // namespace usvfdi::fleet::test

@@ -44,7 +44,7 @@
 #include "netns_fleet.hpp"
 #include "process.hpp"
 
-namespace usv_fdi::fleet::test {
+namespace usvfdi::fleet::test {
 
 class ServiceFleet {
  public:
@@ -120,4 +120,4 @@ class ServiceFleet {
   std::map<std::string, std::unique_ptr<dds::test::ChildProcess>> procs_;
 };
 
-}  // namespace usv_fdi::fleet::test
+}  // namespace usvfdi::fleet::test

@@ -32,7 +32,7 @@
 #include "monitor_log.hpp"
 #include "service_fleet.hpp"
 
-namespace usv_fdi::fleet::test {
+namespace usvfdi::fleet::test {
 namespace {
 
 using std::chrono::milliseconds;
@@ -592,4 +592,4 @@ TEST(FleetPartition, ShorterThanTheLeaseRepairedByReliableResend) { partition_te
 TEST(FleetPartition, LongerThanTheLeaseRediscoveredWithTheLatchedState) { partition_test(true); }
 
 }  // namespace
-}  // namespace usv_fdi::fleet::test
+}  // namespace usvfdi::fleet::test

@@ -10,7 +10,7 @@
 #include "netns_fleet.hpp"
 #include "process.hpp"
 
-namespace usv_fdi::fleet::test {
+namespace usvfdi::fleet::test {
 namespace {
 
 using dds::test::ChildProcess;
@@ -68,4 +68,4 @@ TEST(NetnsFleet, NodesHaveTheirAddressesAndAreRemovedAfterwards) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::fleet::test
+}  // namespace usvfdi::fleet::test

@@ -17,7 +17,7 @@
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/io/jsonl.hpp"
-#include "usv_fdi/service/pipeline.hpp"
+#include "usv_fdi/pipeline/pipeline.hpp"
 
 namespace usvfdi {
 namespace {
@@ -94,7 +94,7 @@ struct Sink {
 
 /// Waits (without a time limit: a busy machine is slow, not wrong) until the isolation
 /// thread has handled `inputs` inputs and the sink holds every event it emitted.
-void settle(const FdiPipeline& p, Sink* sink, std::uint64_t inputs) {
+void settle(const pipeline::FdiPipeline& p, Sink* sink, std::uint64_t inputs) {
   while (p.inputs_handled() < inputs || sink->size() < p.events_emitted()) {
     std::this_thread::sleep_for(std::chrono::microseconds(50));
   }
@@ -105,7 +105,7 @@ void settle(const FdiPipeline& p, Sink* sink, std::uint64_t inputs) {
 /// runs far ahead of it unless it waits for its estimates.
 PerSensor run_pipeline(const GoldenCase& c, bool burst) {
   const EngineConfig cfg = io::load_engine_config(kRoot + "/" + c.config);
-  PipelineOptions opt;
+  pipeline::PipelineOptions opt;
   opt.input_timeout = 1e9;  // wall-clock silence must not inject samples on a busy machine
   opt.input_capacity = 1 << 20;
   opt.estimate_wait = 1e3;  // a slowed thread is slow, not wedged
@@ -115,13 +115,13 @@ PerSensor run_pipeline(const GoldenCase& c, bool burst) {
     }
   };
   Sink sink;
-  FdiPipeline p(
+  pipeline::FdiPipeline p(
       cfg, opt,
       [&sink](const FaultEvent& e) {
         std::lock_guard<std::mutex> l(sink.m);
         sink.events.push_back(e);
       },
-      nullptr, burst ? FdiPipeline::LogSink(slow_identification) : nullptr);
+      nullptr, burst ? pipeline::FdiPipeline::LogSink(slow_identification) : nullptr);
   p.start();
   io::CsvSampleReader reader(kRoot + "/tests/golden/" + c.name + ".csv");
   std::uint64_t pushed = 0;

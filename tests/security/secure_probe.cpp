@@ -55,15 +55,15 @@
 namespace {
 
 namespace fdds = eprosima::fastdds::dds;
-using usv_fdi::dds::DdsConfig;
-using usv_fdi::dds::DdsContext;
-namespace profiles = usv_fdi::dds::profiles;
+using usvfdi::dds::DdsConfig;
+using usvfdi::dds::DdsContext;
+namespace profiles = usvfdi::dds::profiles;
 using Clock = std::chrono::steady_clock;
-using usv_fdi::test_support::probe::deadline_after;
-using usv_fdi::test_support::probe::g_stop;
-using usv_fdi::test_support::probe::install_signal_handlers;
-using usv_fdi::test_support::probe::parse_unsigned;
-using usv_fdi::test_support::probe::UsageError;
+using usvfdi::test_support::probe::deadline_after;
+using usvfdi::test_support::probe::g_stop;
+using usvfdi::test_support::probe::install_signal_handlers;
+using usvfdi::test_support::probe::parse_unsigned;
+using usvfdi::test_support::probe::UsageError;
 
 struct Options {
   std::string mode;
@@ -154,7 +154,7 @@ void say(const std::string& line) {
 std::unique_ptr<DdsContext> make_context(const Options& o) {
   // The security profiles go first so that DdsContext finds the participant profile; the QoS
   // profiles it loads next define the writer and reader profiles.
-  if (!o.security_file.empty()) usv_fdi::dds::load_profiles_file(o.security_file);
+  if (!o.security_file.empty()) usvfdi::dds::load_profiles_file(o.security_file);
   return std::make_unique<DdsContext>(o.dds);
 }
 
@@ -172,7 +172,7 @@ int run_sidecar(const Options& o) {
     e.kind(fdi::KIND_BIAS);
     e.sequence(1);
     e.message("secret fault of " + std::to_string(o.mmsi) + "/" + std::to_string(s));
-    usv_fdi::dds::write(events, e);
+    usvfdi::dds::write(events, e);
   }
   say("ready");
 
@@ -188,8 +188,8 @@ int run_sidecar(const Options& o) {
     (void)waitset.wait(active, eprosima::fastrtps::Duration_t(0, 100000000));
     ins_batch.clear();
     ack_batch.clear();
-    usv_fdi::dds::take_all(ins, ins_batch);
-    usv_fdi::dds::take_all(acks, ack_batch);
+    usvfdi::dds::take_all(ins, ins_batch);
+    usvfdi::dds::take_all(acks, ack_batch);
     for (const auto& s : ins_batch) {
       say("ins mmsi=" + std::to_string(s.mmsi()) + " seq=" + std::to_string(s.seq()));
     }
@@ -262,7 +262,7 @@ int run_peer(const Options& o) {
         s.v_valid(true);
         s.r_valid(true);
         try {
-          usv_fdi::dds::write(*ins, s);
+          usvfdi::dds::write(*ins, s);
           ++ins_written;
         } catch (const std::runtime_error&) {  // counted as not written
         }
@@ -275,7 +275,7 @@ int run_peer(const Options& o) {
         a.operator_id(o.operator_id);
         a.stamp(0.1 * acks_written);
         try {
-          usv_fdi::dds::write(*acks, a);
+          usvfdi::dds::write(*acks, a);
           ++acks_written;
         } catch (const std::runtime_error&) {
         }
@@ -283,7 +283,7 @@ int run_peer(const Options& o) {
     }
     if (faults != nullptr) {
       batch.clear();
-      usv_fdi::dds::take_all(*faults, batch);
+      usvfdi::dds::take_all(*faults, batch);
       for (const auto& e : batch) seen[{e.mmsi(), static_cast<unsigned>(e.sensor())}] = e;
       if (o.until_faults > 0 && !done_at && seen.size() >= o.until_faults) {
         done_at = Clock::now() + std::chrono::seconds(2);  // the acks written meanwhile arrive too

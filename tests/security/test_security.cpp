@@ -28,7 +28,7 @@
 
 #include "process.hpp"
 
-namespace usv_fdi::security::test {
+namespace usvfdi::security::test {
 namespace {
 
 using dds::test::ChildProcess;
@@ -475,4 +475,4 @@ TEST_F(SecurityTest, PayloadsAreEncryptedOnTheWire) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::security::test
+}  // namespace usvfdi::security::test

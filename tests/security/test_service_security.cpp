@@ -31,7 +31,7 @@
 #include "monitor_log.hpp"
 #include "process.hpp"
 
-namespace usv_fdi::security::test {
+namespace usvfdi::security::test {
 namespace {
 
 using dds::test::ChildProcess;
@@ -673,4 +673,4 @@ TEST_F(ServiceSecurity, ExpiredCredentialsEndTheSessionsAlreadyOpen) {
 }
 
 }  // namespace
-}  // namespace usv_fdi::security::test
+}  // namespace usvfdi::security::test

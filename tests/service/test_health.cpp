@@ -15,7 +15,7 @@
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/dds_service/health.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 namespace {
 
 namespace fs = std::filesystem;
@@ -61,9 +61,10 @@ TEST(HealthFile, FreshRunningIsHealthyWhateverTheInputs) {
   EXPECT_TRUE(v.healthy) << v.line;
   EXPECT_EQ(v.line.rfind("healthy: running", 0), 0u) << v.line;
   // A silent INS, a missing rudder, queue drops: reported, not a health problem.
-  r.input_flags = kInputInsSilent | kInputRudderMissing | kInputQueueDrops;
+  r.input_flags =
+      pipeline::kInputInsSilent | pipeline::kInputRudderMissing | pipeline::kInputQueueDrops;
   r.live.ins_age = 42.0;
-  r.isolation_paused = kPauseInsSilent;
+  r.isolation_paused = pipeline::kPauseInsSilent;
   v = write_and_check(path, r, 10.0, r.time + 0.5);
   EXPECT_TRUE(v.healthy) << v.line;
   EXPECT_NE(v.line.find("ins_silent,rudder_missing,queue_drops (not a health problem)"),
@@ -155,7 +156,7 @@ TEST(HealthFile, JudgeNamesEveryStalledThread) {
 class TrapLog {
  public:
   explicit TrapLog(std::string trap) : trap_(std::move(trap)) {}
-  FdiPipeline::LogSink sink() {
+  pipeline::FdiPipeline::LogSink sink() {
     return [this](int, const std::string& msg) {
       if (msg.find(trap_) == std::string::npos) return;
       std::unique_lock<std::mutex> lock(m_);
@@ -183,7 +184,7 @@ class TrapLog {
 
 /// Waits (bounded) until pred(liveness) holds.
 template <class Pred>
-bool wait_liveness(const FdiPipeline& p, milliseconds timeout, Pred pred) {
+bool wait_liveness(const pipeline::FdiPipeline& p, milliseconds timeout, Pred pred) {
   const auto end = Clock::now() + timeout;
   while (Clock::now() < end) {
     if (pred(p.liveness())) return true;
@@ -206,10 +207,10 @@ EngineConfig otter_config() {
 TEST(PipelineLiveness, AWedgedIsolationThreadIsReportedStalled) {
   // GIVEN a running pipeline, idle: every thread goes round its loop
   TrapLog trap("ack of");
-  PipelineOptions opt;
-  FdiPipeline p(otter_config(), opt, nullptr, nullptr, trap.sink());
+  pipeline::PipelineOptions opt;
+  pipeline::FdiPipeline p(otter_config(), opt, nullptr, nullptr, trap.sink());
   p.start();
-  ASSERT_TRUE(wait_liveness(p, milliseconds(5000), [](const PipelineLiveness& l) {
+  ASSERT_TRUE(wait_liveness(p, milliseconds(5000), [](const pipeline::PipelineLiveness& l) {
     return l.isolation < 0.5 && l.identification < 0.5 && l.publisher < 0.5;
   }));
   HealthReport r = running_report();
@@ -222,7 +223,7 @@ TEST(PipelineLiveness, AWedgedIsolationThreadIsReportedStalled) {
   p.push_ack({Sensor::kGyro, 5, "op"});
   ASSERT_TRUE(trap.wait_caught(milliseconds(5000)));
   ASSERT_TRUE(wait_liveness(p, milliseconds(10000),
-                            [](const PipelineLiveness& l) { return l.isolation > 1.5; }));
+                            [](const pipeline::PipelineLiveness& l) { return l.isolation > 1.5; }));
   // THEN its age grows while the other threads still go round, and the judge says which
   r.live = p.liveness();
   judge_threads(&r);
@@ -239,7 +240,7 @@ TEST(PipelineLiveness, AWedgedIsolationThreadIsReportedStalled) {
   // AND once it is released it goes round again
   trap.release();
   EXPECT_TRUE(wait_liveness(p, milliseconds(5000),
-                            [](const PipelineLiveness& l) { return l.isolation < 0.5; }));
+                            [](const pipeline::PipelineLiveness& l) { return l.isolation < 0.5; }));
   p.stop();
 }
 
@@ -247,9 +248,9 @@ TEST(PipelineLiveness, AWedgedIdentificationThreadIsReportedStalled) {
   // GIVEN a pipeline fed the paper's scenario (noise-free Otter) until A converges, whose
   // identification thread wedges when it reports the convergence
   TrapLog trap("identification: A converged");
-  PipelineOptions opt;
+  pipeline::PipelineOptions opt;
   opt.input_capacity = 1 << 16;
-  FdiPipeline p(otter_config(), opt, nullptr, nullptr, trap.sink());
+  pipeline::FdiPipeline p(otter_config(), opt, nullptr, nullptr, trap.sink());
   p.start();
   VesselModel v;
   ASSERT_TRUE(find_vessel("otter", &v));
@@ -262,8 +263,9 @@ TEST(PipelineLiveness, AWedgedIdentificationThreadIsReportedStalled) {
   }
   ASSERT_TRUE(trap.wait_caught(milliseconds(20000))) << "A never converged";
   // WHEN it stays wedged
-  ASSERT_TRUE(wait_liveness(p, milliseconds(10000),
-                            [](const PipelineLiveness& l) { return l.identification > 1.5; }));
+  ASSERT_TRUE(wait_liveness(p, milliseconds(10000), [](const pipeline::PipelineLiveness& l) {
+    return l.identification > 1.5;
+  }));
   // THEN the judge names it, while the isolation thread still goes round
   HealthReport r = running_report();
   r.live = p.liveness();
@@ -274,10 +276,11 @@ TEST(PipelineLiveness, AWedgedIdentificationThreadIsReportedStalled) {
   EXPECT_EQ(r.reason.find("isolation thread"), std::string::npos) << r.reason;
   EXPECT_GE(r.live.ins_age, 0.0);
   trap.release();
-  EXPECT_TRUE(wait_liveness(p, milliseconds(5000),
-                            [](const PipelineLiveness& l) { return l.identification < 0.5; }));
+  EXPECT_TRUE(wait_liveness(p, milliseconds(5000), [](const pipeline::PipelineLiveness& l) {
+    return l.identification < 0.5;
+  }));
   p.stop();
 }
 
 }  // namespace
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

@@ -18,7 +18,7 @@
 #include "usv_fdi/dds_service/journal.hpp"
 #include "usv_fdi/io/jsonl.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 namespace {
 
 namespace fs = std::filesystem;
@@ -307,4 +307,4 @@ TEST(StateJournal, LoadNamesTheFileAndSetAsideKeepsTheBadOne) {
 }
 
 }  // namespace
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

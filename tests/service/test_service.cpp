@@ -24,10 +24,9 @@
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 namespace {
 
-namespace dds = usv_fdi::dds;
 namespace fdds = eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 using std::chrono::milliseconds;
@@ -317,7 +316,7 @@ TEST(ServiceInProcess, ARestartWithoutStateNeverRepeatsAnEventAndRefusesTheOldRu
 }
 
 TEST(SeqGaps, GapsAreLostSamplesLateOnesAreTakenOffARestartIsNoLoss) {
-  FdiPipeline::SeqGaps g;
+  pipeline::FdiPipeline::SeqGaps g;
   g.see(0);  // not numbered: ignored
   EXPECT_EQ(g.lost(), 0u);
   // GIVEN a stream that starts at 100 (a late joiner: nothing before counts) with two gaps
@@ -365,11 +364,11 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
   std::this_thread::sleep_for(milliseconds(700));
   // WHEN it stops (listeners detached, queues shut down, threads joined, DDS entities
   // deleted) while the writers keep going
-  usv_fdi::dds::test::StarvationMeter meter;
+  usvfdi::dds::test::StarvationMeter meter;
   const auto t0 = Clock::now();
   svc->stop();
   const double took = std::chrono::duration<double>(Clock::now() - t0).count();
-  const PipelineStatus st = svc->status();
+  const pipeline::PipelineStatus st = svc->status();
   svc.reset();
   go = false;
   ta.join();
@@ -398,4 +397,4 @@ TEST(ServiceInProcess, RefusesAMissingMmsiAndAnUnknownProfileByName) {
 }
 
 }  // namespace
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

@@ -11,7 +11,7 @@
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 namespace {
 
 const std::string kSource = USV_FDI_SOURCE_DIR;
@@ -160,4 +160,4 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
 }
 
 }  // namespace
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

@@ -12,9 +12,9 @@
 
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
-#include "usv_fdi/service/pipeline.hpp"
+#include "usv_fdi/pipeline/pipeline.hpp"
 
-namespace usvfdi {
+namespace usvfdi::pipeline {
 namespace {
 
 TEST(BoundedQueue, DropsOldestWhenFullAndCountsIt) {
@@ -842,4 +842,4 @@ TEST(FdiPipelineOutput, AnOverflowStillPublishesTheLatestStateOfEveryInstance) {
 }
 
 }  // namespace
-}  // namespace usvfdi
+}  // namespace usvfdi::pipeline

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "usv_fdi/core/detection.hpp"
 #include "usv_fdi/core/healthy_maxima.hpp"
 #include "usv_fdi/core/identification.hpp"
 #include "usv_fdi/core/jump_check.hpp"
@@ -109,19 +110,6 @@ struct IsolationParams {
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
-};
-
-/// A change of the fault condition of one sensor (the latch turns it into events).
-struct Detection {
-  Sensor sensor = Sensor::kUnknown;
-  bool active = false;  ///< true: condition raised; false: condition cleared
-  bool update = false;  ///< a raised condition's kind was refined (no state change)
-  FaultKind kind = FaultKind::kUnknown;
-  double c_a = 0.0, c_g = 0.0;
-  double statistic = 0.0, threshold = 0.0;
-  double onset_time = kNaN;      ///< estimated onset [s, source clock]
-  double detection_time = kNaN;  ///< sample time of the decision [s]
-  std::string message;
 };
 
 /// Reason flags for the inputs (FdiStatus).

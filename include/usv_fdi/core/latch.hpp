@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string>
 
-#include "usv_fdi/core/isolation.hpp"
+#include "usv_fdi/core/detection.hpp"
 #include "usv_fdi/core/types.hpp"
 
 namespace usvfdi {

@@ -24,7 +24,7 @@
 #include "usv_fdi/dds/profiles.hpp"
 #include "usv_fdi/dds/types.hpp"
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 
 /// DDS topic names, indexed by TopicId.
 struct TopicNames {
@@ -153,4 +153,4 @@ std::size_t take_all(eprosima::fastdds::dds::DataReader& reader, std::vector<T>&
   return n;
 }
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 
 class PeerDirectory : public eprosima::fastdds::dds::DomainParticipantListener {
  public:
@@ -59,4 +59,4 @@ std::uint32_t vessel_of_partition(const std::string& partition);
 /// The vessel a writer is confined to: the MMSI of its only partition, 0 if it has none or several.
 std::uint32_t vessel_of_writer(const std::vector<std::string>& partitions);
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

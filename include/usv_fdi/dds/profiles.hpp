@@ -4,7 +4,7 @@
 
 #include <string>
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 
 /// Profile names defined in config/qos/usv_fdi_profiles.xml.
 namespace profiles {
@@ -47,4 +47,4 @@ void load_profiles_file(const std::string& path);
 /// Loads only the default profiles (see above). Throws std::runtime_error on failure.
 void load_default_profiles();
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

@@ -7,7 +7,7 @@
 #include "usv_fdi.h"
 #include "usv_fdiPubSubTypes.h"
 
-namespace usv_fdi::dds {
+namespace usvfdi::dds {
 
 /// The five topics of the service. The value indexes TopicNames / DdsContext::topic().
 enum class TopicId : std::size_t { kIns = 0, kRudder, kFaultEvent, kFaultAck, kStatus };
@@ -47,4 +47,4 @@ struct TopicTraits<fdi::FdiStatus> {
 /// Human-readable name of a topic id ("ins", "rudder", "fault_event", "fault_ack", "status").
 std::string_view to_string(TopicId id) noexcept;
 
-}  // namespace usv_fdi::dds
+}  // namespace usvfdi::dds

@@ -19,9 +19,9 @@
 #include <cstdint>
 #include <string>
 
-#include "usv_fdi/service/pipeline.hpp"
+#include "usv_fdi/pipeline/pipeline.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 
 struct HealthReport {
   double time = 0.0;  ///< [s since the Unix epoch]
@@ -31,7 +31,7 @@ struct HealthReport {
   std::string reason;
   double period = 1.0;       ///< how often the file is rewritten [s]
   double stall_limit = 5.0;  ///< a thread that has not gone round its loop for this long [s]
-  PipelineLiveness live;
+  pipeline::PipelineLiveness live;
   std::uint64_t samples = 0;
   bool converged = false, armed = false;
   std::uint32_t input_flags = 0;
@@ -61,4 +61,4 @@ struct HealthVerdict {
 /// max_age <= 0: three of the file's periods, at least 3 s.
 HealthVerdict check_health_file(const std::string& path, double max_age, double now_unix);
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

@@ -40,7 +40,7 @@
 
 #include "usv_fdi/core/latch.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 
 /// Where the sidecar keeps its state when neither service.state_dir nor --state-dir is given:
 /// used if the directory exists (the container images and packages create it), otherwise
@@ -108,4 +108,4 @@ class StateJournal {
   std::uint64_t saves_ = 0;
 };
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

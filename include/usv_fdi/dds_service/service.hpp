@@ -11,14 +11,14 @@
 #include "usv_fdi/core/engine.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 #include "usv_fdi/dds_service/journal.hpp"
-#include "usv_fdi/service/pipeline.hpp"
+#include "usv_fdi/pipeline/pipeline.hpp"
 
-namespace usvfdi::service {
+namespace usvfdi::dds_service {
 
 struct ServiceConfig {
   EngineConfig engine;
-  PipelineOptions pipeline;
-  usv_fdi::dds::DdsConfig dds;
+  pipeline::PipelineOptions pipeline;
+  usvfdi::dds::DdsConfig dds;
   std::uint32_t mmsi = 0;        ///< the vessel this sidecar watches (required, > 0)
   bool reliable_inputs = false;  ///< INS and rudder readers RELIABLE instead of BEST_EFFORT
   std::string log_level = "info";
@@ -54,7 +54,7 @@ class StateInUse : public std::runtime_error {
 
 class FdiService {
  public:
-  using LogSink = FdiPipeline::LogSink;
+  using LogSink = pipeline::FdiPipeline::LogSink;
   /// Creates every DDS entity and the pipeline; throws std::runtime_error naming what failed,
   /// StateInUse when another sidecar holds <state_dir>/usv-fdi-<mmsi>.lock.
   FdiService(const ServiceConfig& cfg, LogSink log);
@@ -66,10 +66,10 @@ class FdiService {
   /// Stops the listeners' feed, drains and joins the threads, deletes the DDS entities.
   /// Idempotent; the destructor calls it.
   void stop();
-  PipelineStatus status() const { return pipeline_->status(); }
+  pipeline::PipelineStatus status() const { return pipeline_->status(); }
   /// This run's incarnation (FaultEvent.incarnation of the events it issues).
   std::uint64_t incarnation() const { return pipeline_->incarnation(); }
-  PipelineLiveness liveness() const { return pipeline_->liveness(); }
+  pipeline::PipelineLiveness liveness() const { return pipeline_->liveness(); }
 
   /// The state journal's file ("" when state is not persisted) and the error of its last
   /// failed save ("" when fine).
@@ -107,17 +107,17 @@ class FdiService {
   std::unique_ptr<StateJournal> journal_;
   std::vector<FaultEvent> restored_;
   std::string journal_error_logged_;  ///< publisher thread: the save error already logged
-  std::unique_ptr<FdiPipeline> pipeline_;
+  std::unique_ptr<pipeline::FdiPipeline> pipeline_;
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<EventWatch> watch_;
   int lock_fd_ = -1;  ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
-  std::unique_ptr<usv_fdi::dds::DdsContext> dds_;
+  std::unique_ptr<usvfdi::dds::DdsContext> dds_;
   /// The participant of the ack reader alone (its own port and receive thread).
-  std::unique_ptr<usv_fdi::dds::DdsContext> ack_dds_;
+  std::unique_ptr<usvfdi::dds::DdsContext> ack_dds_;
   eprosima::fastdds::dds::DataWriter* event_writer_ = nullptr;
   eprosima::fastdds::dds::DataWriter* status_writer_ = nullptr;
   eprosima::fastdds::dds::DataReader* event_watch_ = nullptr;  ///< FaultEvent, for EventWatch
   bool stopped_ = false;
 };
 
-}  // namespace usvfdi::service
+}  // namespace usvfdi::dds_service

@@ -1,4 +1,4 @@
-#include "usv_fdi/service/pipeline.hpp"
+#include "usv_fdi/pipeline/pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace usvfdi {
+namespace usvfdi::pipeline {
 
 // ---------------------------------------------------------------- SampleAssembler
 
@@ -907,4 +907,4 @@ void FdiPipeline::publisher_loop() {
   }
 }
 
-}  // namespace usvfdi
+}  // namespace usvfdi::pipeline

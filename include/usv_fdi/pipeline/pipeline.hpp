@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "usv_fdi/core/engine.hpp"
-#include "usv_fdi/service/bounded_queue.hpp"
+#include "usv_fdi/pipeline/bounded_queue.hpp"
 
-namespace usvfdi {
+namespace usvfdi::pipeline {
 
 struct InsInput {
   double stamp = kNaN;  ///< source time [s]
@@ -415,4 +415,4 @@ class FdiPipeline {
   bool started_ = false, stopped_ = false;
 };
 
-}  // namespace usvfdi
+}  // namespace usvfdi::pipeline

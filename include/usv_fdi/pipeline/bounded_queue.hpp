@@ -8,7 +8,7 @@
 #include <mutex>
 #include <utility>
 
-namespace usvfdi {
+namespace usvfdi::pipeline {
 
 enum class OverflowPolicy : std::uint8_t {
   kDropOldest = 0,  ///< a full queue discards its oldest element (inputs: newest data wins)
@@ -91,4 +91,4 @@ class BoundedQueue {
   bool shutdown_ = false;
 };
 
-}  // namespace usvfdi
+}  // namespace usvfdi::pipeline
