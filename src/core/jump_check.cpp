@@ -314,6 +314,38 @@ JumpVerdict JumpCheck::update(double t, double y, double delta, bool learn_ok) {
 JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   JumpVerdict v;
   if (!std::isfinite(t)) return v;
+  integrate_rudder(t, delta);
+  if (!std::isfinite(y)) return v;
+  if (raised_ && t - raised_at_ >= p_.hold_max) {
+    raised_ = false;
+    v.step = JumpVerdict::Change::kClear;
+    v.message = "no jump back within " + std::to_string(p_.hold_max) + " s";
+  }
+  if (!learn_interval(t)) return v;
+  if (!take_sample(t, y)) return v;
+
+  if (sigma_ <= 0) sigma_ = floor_;
+  if (sigma2_ <= 0) sigma2_ = floor_;
+  int m_best = -1;
+  double f_best = 0.0;
+  step_statistics(&m_best, &f_best);
+  // The innovation (the one-step prediction error) and the second difference.
+  const double e2 = f_[0] * f_[0] / c_[0];
+  const double d2 = z_.at(0) - 2.0 * z_.at(1) + z_.at(2);
+  noise_statistic(d2 * d2);
+  queue_for_learning(Pending{t, T_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_});
+  armed_ = p_.enabled && learned_ >= p_.learn_time;
+  // Watched from half the learning on (the scales have settled), reported once armed: a
+  // fault before arming is kept out of the learning, and its end is not taken for a new one.
+  if (!p_.enabled || learned_ < 0.5 * p_.learn_time) return v;
+  threshold_ = std::max(p_.threshold, p_.margin * healthy_.extrapolated_max(0));
+  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * healthy_.extrapolated_max(1));
+  if (decide_noise(t, &v)) return v;
+  decide_step(t, m_best, f_best, &v);
+  return v;
+}
+
+void JumpCheck::integrate_rudder(double t, double delta) {
   // The rudder integral over every interval, once (the angle held over a missing one),
   // whether or not this sample's y is usable.
   const double d_now = std::isfinite(delta) ? delta : last_delta_;
@@ -322,27 +354,27 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   }
   int_t_ = t;
   last_delta_ = d_now;
-  if (!std::isfinite(y)) return v;
-  if (raised_ && t - raised_at_ >= p_.hold_max) {
-    raised_ = false;
-    v.step = JumpVerdict::Change::kClear;
-    v.message = "no jump back within " + std::to_string(p_.hold_max) + " s";
-  }
+}
+
+bool JumpCheck::learn_interval(double t) {
   // The sample interval, from the first samples.
-  if (dt_seen_ < kIntervalSamples) {
-    first_t_.push_back(t);
-    if (++dt_seen_ < kIntervalSamples) return v;
-    std::vector<double> d(first_t_.size() - 1);
-    for (std::size_t i = 0; i < d.size(); ++i) d[i] = first_t_[i + 1] - first_t_[i];
-    dt_ = median_in_place(&d);
-    std::vector<double>().swap(first_t_);
-    if (!(dt_ > 0)) {
-      dt_seen_ = 0;
-      return v;
-    }
-    resize_windows();
-    restart();
+  if (dt_seen_ >= kIntervalSamples) return true;
+  first_t_.push_back(t);
+  if (++dt_seen_ < kIntervalSamples) return false;
+  std::vector<double> d(first_t_.size() - 1);
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = first_t_[i + 1] - first_t_[i];
+  dt_ = median_in_place(&d);
+  std::vector<double>().swap(first_t_);
+  if (!(dt_ > 0)) {
+    dt_seen_ = 0;
+    return false;
   }
+  resize_windows();
+  restart();
+  return true;
+}
+
+bool JumpCheck::take_sample(double t, double y) {
   // A long gap restarts the windows (and the rudder integral, so z is computed after), as
   // does a rudder integral grown too large for its round-off.
   if (std::isfinite(last_t_) && (t - last_t_ > p_.max_gap || std::abs(I_) > kRebase)) {
@@ -365,18 +397,10 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   last_z_ = z;
   last_I_ = I_;
   last_d_ = dl;
-  if (z_.count() < L_ + 1 || z_.count() < 3) return v;
+  return z_.count() >= L_ + 1 && z_.count() >= 3;
+}
 
-  if (sigma_ <= 0) sigma_ = floor_;
-  if (sigma2_ <= 0) sigma2_ = floor_;
-  int m_best = -1;
-  double f_best = 0.0;
-  step_statistics(&m_best, &f_best);
-  // The innovation (the one-step prediction error) and the second difference.
-  const double e2 = f_[0] * f_[0] / c_[0];
-  const double d2 = z_.at(0) - 2.0 * z_.at(1) + z_.at(2);
-  noise_statistic(d2 * d2);
-
+void JumpCheck::queue_for_learning(const Pending& s) {
   // Learning trails the decisions by the post window: a fault's first samples, seen before
   // it is detected, are dropped with the detection.
   const std::size_t P = pending_.size();
@@ -385,52 +409,47 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
     pending_head_ = (pending_head_ + 1) % P;
     --pending_n_;
   }
-  pending_[(pending_head_ + pending_n_) % P] =
-      Pending{t, T_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_};
+  pending_[(pending_head_ + pending_n_) % P] = s;
   ++pending_n_;
-  armed_ = p_.enabled && learned_ >= p_.learn_time;
-  // Watched from half the learning on (the scales have settled), reported once armed: a
-  // fault before arming is kept out of the learning, and its end is not taken for a new one.
-  if (!p_.enabled || learned_ < 0.5 * p_.learn_time) return v;
-  threshold_ = std::max(p_.threshold, p_.margin * healthy_.extrapolated_max(0));
-  noise_threshold_ = std::max(p_.noise_threshold, p_.margin * healthy_.extrapolated_max(1));
+}
 
-  // Noise rise.
+bool JumpCheck::decide_noise(double t, JumpVerdict* v) {
   if (!noise_raised_ && N_ > noise_threshold_) {
     noise_raised_ = true;
     noise_raised_at_ = t;
     noise_below_since_ = kNaN;
-    v.noise = JumpVerdict::Change::kRaise;
+    v->noise = JumpVerdict::Change::kRaise;
     pending_n_ = 0;
     char buf[160];
     std::snprintf(buf, sizeof buf, "noise: innovation mean square %.3g > %.3g (scale %.3g)", N_,
                   noise_threshold_, sigma2_);
-    v.message = buf;
+    v->message = buf;
     if (raised_ && t - raised_at_ <= 2.0 * p_.noise_window) {
       raised_ = false;  // the jump raised just before was the first samples of this noise
-      v.message += "; the jump before it was this";
+      v->message += "; the jump before it was this";
     }
-    return v;
+    return true;
   }
   if (noise_raised_ && !noise_reported_ && !armed_ && t - noise_raised_at_ >= p_.hold_max) {
     noise_raised_ = false;  // a rise watched before arming must not stop the learning forever
   }
-  if (noise_raised_) {
-    if (d2_n_ < d2_.size()) return v;  // refilling after a restart: no verdict
-    if (N_ < p_.exit_ratio * noise_threshold_) {
-      if (std::isnan(noise_below_since_)) noise_below_since_ = t;
-      if (t - noise_below_since_ >= p_.leave_time) {
-        noise_raised_ = false;
-        v.noise = JumpVerdict::Change::kClear;
-        v.message = "noise back below " + std::to_string(p_.exit_ratio * noise_threshold_);
-      }
-    } else {
-      noise_below_since_ = kNaN;
+  if (!noise_raised_) return false;
+  if (d2_n_ < d2_.size()) return true;  // refilling after a restart: no verdict
+  if (N_ < p_.exit_ratio * noise_threshold_) {
+    if (std::isnan(noise_below_since_)) noise_below_since_ = t;
+    if (t - noise_below_since_ >= p_.leave_time) {
+      noise_raised_ = false;
+      v->noise = JumpVerdict::Change::kClear;
+      v->message = "noise back below " + std::to_string(p_.exit_ratio * noise_threshold_);
     }
-    return v;
+  } else {
+    noise_below_since_ = kNaN;
   }
-  // Step.
-  if (m_best < 0 || !(T_ > threshold_) || !persists(m_best, f_best)) return v;
+  return true;
+}
+
+void JumpCheck::decide_step(double t, int m_best, double f_best, JumpVerdict* v) {
+  if (m_best < 0 || !(T_ > threshold_) || !persists(m_best, f_best)) return;
   const int cap = static_cast<int>(ts_.size());
   const double onset = ts_[static_cast<std::size_t>((z_.newest() - m_best + cap) % cap)];
   pending_n_ = 0;
@@ -439,27 +458,26 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
     raised_ = true;
     offset_ = f_best;
     raised_at_ = t;
-    v.step = JumpVerdict::Change::kRaise;
-    v.onset = onset;
-    v.size = f_best;
+    v->step = JumpVerdict::Change::kRaise;
+    v->onset = onset;
+    v->size = f_best;
     std::snprintf(buf, sizeof buf, "jump of %+.4g at %.3f s: T %.3g > %.3g (scale %.3g)", f_best,
                   onset, T_, threshold_, sigma_);
-    v.message = buf;
+    v->message = buf;
   } else if (f_best * offset_ > 0 || std::abs(f_best) < 0.5 * std::abs(offset_)) {
     offset_ += f_best;  // it grew, or came back part of the way
   } else {
     offset_ += f_best;
     raised_ = false;
-    v.step = JumpVerdict::Change::kClear;
-    v.onset = onset;
-    v.size = f_best;
+    v->step = JumpVerdict::Change::kClear;
+    v->onset = onset;
+    v->size = f_best;
     std::snprintf(buf, sizeof buf, "jump back of %+.4g at %.3f s (offset left %+.3g)", f_best,
                   onset, offset_);
-    v.message = buf;
+    v->message = buf;
   }
   // The step leaves every window: keep only the samples from its onset on.
   keep_newest(m_best + 1);
-  return v;
 }
 
 }  // namespace usvfdi

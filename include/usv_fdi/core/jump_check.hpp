@@ -138,6 +138,19 @@ class JumpCheck {
   };
 
   JumpVerdict decide(double t, double y, double delta, bool learn_ok);
+  /// Adds the interval since the last sample to the rudder integral I_.
+  void integrate_rudder(double t, double delta);
+  /// Learns the sample interval from the first samples; true once it is known.
+  bool learn_interval(double t);
+  /// Puts z = y - b I (and the dropped samples before it) in the windows; true once they
+  /// hold enough for the statistics.
+  bool take_sample(double t, double y);
+  /// Queues a sample for learning, learning from the oldest queued one once the queue is full.
+  void queue_for_learning(const Pending& s);
+  /// The noise rise's raise and clear; true when it decided the sample (no step verdict).
+  bool decide_noise(double t, JumpVerdict* v);
+  /// The step's raise, growth and jump back.
+  void decide_step(double t, int m_best, double f_best, JumpVerdict* v);
   void resize_windows();
   void restart();
   /// Keeps only the newest `keep` samples (a jump leaves every window).
