@@ -184,26 +184,56 @@ bool Identifier::update(const Sample& s, bool freeze) {
     return true;
   }
   const double dt = s.t - prev_.t;
-  const Vec2 y(s.v, s.r), y_prev(prev_.v, prev_.r);
+  const bool rudder_iv =
+      p_.method == IdentMethod::kKreisselmeier && p_.instruments == Instruments::kRudder;
+  filter_sample(s, dt, sr, rudder_iv);
+  prev2_ = prev_;
+  have_prev2_ = true;
+  prev_ = s;
+  s_prev_ = sr;
+  est_.warming_up = s.t - t_start_ < warmup_;
+  if (est_.warming_up) {
+    if (!est_.converged) est_.status = IdentStatus::kWarmingUp;
+    return true;
+  }
+  if (p_.method == IdentMethod::kPaper) {
+    mix_paper();
+  } else {
+    step_memories(s.t, dt, rudder_iv);
+    if (rudder_iv) refresh_aux_model(s.t);
+  }
+  advance_scalar_laws(dt);
+  update_convergence(s.t);
+  return true;
+}
+
+Identifier::InputCorrections Identifier::input_corrections(const Sample& s, double dt) {
   // Curvature of each input over the step (zero until three samples are known), and its
   // change, the cubic term (zero until four are known).
-  Vec3 dd = Vec3::Zero(), c3 = Vec3::Zero();
-  double hp = dt;
-  if (p_.curvature_correction && have_prev2_) {
-    hp = prev_.t - prev2_.t;
-    dd(0) = FohLowPass::curvature(prev2_.v, prev_.v, s.v, hp, dt);
-    dd(1) = FohLowPass::curvature(prev2_.r, prev_.r, s.r, hp, dt);
-    dd(2) = FohLowPass::curvature(prev2_.delta, prev_.delta, s.delta, hp, dt);
-    if (p_.cubic_correction && have_dd_prev_) {
-      for (int i = 0; i < 3; ++i) {
-        c3(i) = FohLowPass::third_difference(dd(i), dd_prev_(i), s.t - t_dd_prev_);
-      }
+  InputCorrections c;
+  c.hp = dt;
+  if (!p_.curvature_correction || !have_prev2_) return c;
+  c.hp = prev_.t - prev2_.t;
+  c.dd(0) = FohLowPass::curvature(prev2_.v, prev_.v, s.v, c.hp, dt);
+  c.dd(1) = FohLowPass::curvature(prev2_.r, prev_.r, s.r, c.hp, dt);
+  c.dd(2) = FohLowPass::curvature(prev2_.delta, prev_.delta, s.delta, c.hp, dt);
+  if (p_.cubic_correction && have_dd_prev_) {
+    for (int i = 0; i < 3; ++i) {
+      c.c3(i) = FohLowPass::third_difference(c.dd(i), dd_prev_(i), s.t - t_dd_prev_);
     }
-    dd_prev_ = dd;
-    t_dd_prev_ = prev2_.t;
-    have_dd_prev_ = true;
   }
-  f1_.set_step(dt, hp);
+  dd_prev_ = c.dd;
+  t_dd_prev_ = prev2_.t;
+  have_dd_prev_ = true;
+  return c;
+}
+
+void Identifier::filter_sample(const Sample& s, double dt, double sr, bool rudder_iv) {
+  const Vec2 y(s.v, s.r), y_prev(prev_.v, prev_.r);
+  const InputCorrections c = input_corrections(s, dt);
+  const Vec3& dd = c.dd;
+  const Vec3& c3 = c.c3;
+  f1_.set_step(dt, c.hp);
   for (int i = 0; i < 2; ++i) q_(i) = f1_.step_cubic(y_prev(i), y(i), dd(i), c3(i), q_(i));
   fd1_ = f1_.step_cubic(prev_.delta, s.delta, dd(2), c3(2), fd1_);
   // The paper's method is kept as written: it knows no speed.
@@ -221,48 +251,31 @@ bool Identifier::update(const Sample& s, bool freeze) {
     fds_ = fd1_;
   }
   m_ = p_.eps1 * (y - q_) - B_ * fds_;
-  const bool rudder_iv =
-      p_.method == IdentMethod::kKreisselmeier && p_.instruments == Instruments::kRudder;
   if (rudder_iv) {
     step_instruments(dt, prev_.delta, s_prev_, sr);
   } else {
     z_ = qs_;
   }
   if (p_.method == IdentMethod::kPaper) {
-    f2_.set_step(dt, hp);
+    f2_.set_step(dt, c.hp);
     for (int i = 0; i < 2; ++i) qb_(i) = f2_.step_cubic(y_prev(i), y(i), dd(i), c3(i), qb_(i));
     fd2_ = f2_.step_cubic(prev_.delta, s.delta, dd(2), c3(2), fd2_);
     mb_ = p_.eps2 * (y - qb_) - B_ * fd2_;
   }
-  prev2_ = prev_;
-  have_prev2_ = true;
-  prev_ = s;
-  s_prev_ = sr;
-  est_.warming_up = s.t - t_start_ < warmup_;
-  if (est_.warming_up) {
-    if (!est_.converged) est_.status = IdentStatus::kWarmingUp;
-    return true;
-  }
+}
 
-  if (p_.method == IdentMethod::kPaper) {
-    // R = [[q1 q2], [qb1 qb2]]; adj(R) = [[qb2 -q2], [-qb1 q1]].
-    Mat2 R;
-    R << q_(0), q_(1), qb_(0), qb_(1);
-    psi_ = R.determinant();
-    Mat2 adj;
-    adj << R(1, 1), -R(0, 1), -R(1, 0), R(0, 0);
-    const Vec2 h12 = adj * Vec2(m_(0), mb_(0));
-    const Vec2 h34 = adj * Vec2(m_(1), mb_(1));
-    h_ << h12, h34;
-    scale_ = R.col(0).norm() * R.col(1).norm();
-    est_.excitation = scale_ > 0 ? std::abs(psi_) / scale_ : 0.0;
-  } else {
-    step_memories(s.t, dt, rudder_iv);
-    if (rudder_iv) refresh_aux_model(s.t);
-  }
-  advance_scalar_laws(dt);
-  update_convergence(s.t);
-  return true;
+void Identifier::mix_paper() {
+  // R = [[q1 q2], [qb1 qb2]]; adj(R) = [[qb2 -q2], [-qb1 q1]].
+  Mat2 R;
+  R << q_(0), q_(1), qb_(0), qb_(1);
+  psi_ = R.determinant();
+  Mat2 adj;
+  adj << R(1, 1), -R(0, 1), -R(1, 0), R(0, 0);
+  const Vec2 h12 = adj * Vec2(m_(0), mb_(0));
+  const Vec2 h34 = adj * Vec2(m_(1), mb_(1));
+  h_ << h12, h34;
+  scale_ = R.col(0).norm() * R.col(1).norm();
+  est_.excitation = scale_ > 0 ? std::abs(psi_) / scale_ : 0.0;
 }
 
 void Identifier::step_memories(double t, double dt, bool rudder_iv) {

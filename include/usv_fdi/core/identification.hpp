@@ -241,6 +241,19 @@ class Identifier {
   void refresh_aux_model(double t);
   void advance_scalar_laws(double dt);
   void update_convergence(double t);
+  using Vec3 = Eigen::Matrix<double, 3, 1>;
+  /// The inputs' curvature over the step and its change (zero until known), and the
+  /// previous step hp [s].
+  struct InputCorrections {
+    Vec3 dd = Vec3::Zero(), c3 = Vec3::Zero();
+    double hp = 0.0;
+  };
+  InputCorrections input_corrections(const Sample& s, double dt);
+  /// One step of every filter: q, F1[delta], the speed-scaled regressor, m, the instruments
+  /// and (the paper's method) the second filter.
+  void filter_sample(const Sample& s, double dt, double sr, bool rudder_iv);
+  /// The paper's mixing: Psi = det R and h = adj(R) [m; mb].
+  void mix_paper();
 
   IdentificationParams p_;
   Vec2 B_;
@@ -252,7 +265,6 @@ class Identifier {
   Sample prev_{};
   Sample prev2_{};  ///< the sample before prev_ (for the curvature)
   bool have_prev2_ = false;
-  using Vec3 = Eigen::Matrix<double, 3, 1>;
   Vec3 dd_prev_ = Vec3::Zero();  ///< curvatures of v, r, delta over the previous stencil
   double t_dd_prev_ = kNaN;      ///< first node of that stencil
   bool have_dd_prev_ = false;
