@@ -437,11 +437,19 @@ bool Isolator::model_live() const {
 }
 
 void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
+  JumpVerdict verdict[2];
+  update_jump_checks(s, verdict);
+  // The isolation confidence of a jump: C_i on the excess evidence of both channels.
+  const Vec2 e(std::sqrt(std::max(0.0, st_.jump_T(0) / std::max(st_.jump_threshold(0), 1.0))),
+               std::sqrt(std::max(0.0, st_.jump_T(1) / std::max(st_.jump_threshold(1), 1.0))));
+  for (int c = 0; c < 2; ++c) apply_jump_verdict(c, verdict[c], e, s.t, out);
+}
+
+void Isolator::update_jump_checks(const Sample& s, JumpVerdict verdict[2]) {
   const double values[2] = {s.v, s.r};
   const double limits[2] = {p_.max_abs_v, p_.max_abs_r};
   const double delta =
       std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta ? s.delta : kNaN;
-  JumpVerdict verdict[2];
   for (int c = 0; c < 2; ++c) {
     const double y =
         std::isfinite(values[c]) && std::abs(values[c]) <= limits[c] ? values[c] : kNaN;
@@ -455,78 +463,83 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
     st_.noise_threshold(c) = jump_[c].noise_threshold();
   }
   st_.jump_armed = jump_[0].armed() && jump_[1].armed();
-  // The isolation confidence of a jump: C_i on the excess evidence of both channels.
-  const Vec2 e(std::sqrt(std::max(0.0, st_.jump_T(0) / std::max(st_.jump_threshold(0), 1.0))),
-               std::sqrt(std::max(0.0, st_.jump_T(1) / std::max(st_.jump_threshold(1), 1.0))));
-  for (int c = 0; c < 2; ++c) {
-    const JumpVerdict& v = verdict[c];
-    const Sensor sensor = channel_sensor(c);
-    const char* name = c == kV ? "accelerometer channel v: " : "gyro channel r: ";
-    const auto patch = [&](std::size_t before, double onset, double stat, double thr) {
-      if (out->size() == before || !out->back().active) return;
-      Detection& d = out->back();
-      if (std::isfinite(onset)) d.onset_time = onset;
-      d.statistic = stat;
-      d.threshold = thr;
-      const Vec2 ec = stat > 0 && e.norm() > 0 ? e : (c == kV ? Vec2(1, 0) : Vec2(0, 1));
-      d.c_a = ec(0) / ec.norm();
-      d.c_g = ec(1) / ec.norm();
-    };
-    if (v.step == JumpVerdict::Change::kRaise) chan_[c].jump_at = s.t;
-    if (v.noise == JumpVerdict::Change::kRaise && sens_[c].cond.active &&
-        sens_[c].cond.kind == FaultKind::kBias &&
-        s.t - chan_[c].jump_at <= 2.0 * p_.jump.noise_window) {
-      // The jump raised just before was the first samples of a noise rise: one condition,
-      // its kind refined.
-      set_condition(sensor, kNoiseRise, true, FaultKind::kNoise, s.t, name + v.message, out);
-      set_condition(sensor, kJump, false, FaultKind::kBias, s.t, name + v.message, out);
-      jump_[c].release();
-      Condition& cd = sens_[c].cond;
-      if (cd.active && cd.kind != FaultKind::kNoise) {
-        Detection d = make_detection(sensor, true, FaultKind::kNoise, s.t);
-        d.update = true;
-        d.message = std::string("kind refined from ") + to_string(cd.kind) + " to noise: " + name +
-                    v.message;
-        cd.kind = FaultKind::kNoise;
-        out->push_back(d);
-      }
-      continue;
-    }
-    if (v.step != JumpVerdict::Change::kNone) {
-      const std::size_t before = out->size();
-      set_condition(sensor, kJump, v.step == JumpVerdict::Change::kRaise, FaultKind::kBias, s.t,
-                    name + v.message, out);
-      patch(before, v.onset, st_.jump_T(c), st_.jump_threshold(c));
-    }
-    // Once the observers are live they hold a jump like any residual fault (their cross
-    // residual sees whether the offset is still there, or has gone without a jump back).
-    if ((sens_[c].cond.sources & kJump) && model_live()) {
-      const bool held = sens_[c].cond.sources & kResidual;  // the observers hold it already
-      set_condition(sensor, kResidual, true, FaultKind::kBias, s.t,
-                    std::string(name) + "held by the observers", out);
-      set_condition(sensor, kJump, false, FaultKind::kBias, s.t, "", out);
-      if (!held) {
-        sens_[c].raised_at = s.t;
-        sens_[c].below_since = kNaN;
-        // Its kind is refined from the residuals' shape like any other (a scale error jumps).
-        if (sens_[c].cond.kind == FaultKind::kBias)
-          chan_[c].refine_at = s.t + 0.5 * p_.classify_window;
-      }
-      jump_[c].release();
-    }
-    if (v.noise != JumpVerdict::Change::kNone) {
-      const std::size_t before = out->size();
-      set_condition(sensor, kNoiseRise, v.noise == JumpVerdict::Change::kRaise, FaultKind::kNoise,
-                    s.t, name + v.message, out);
-      patch(before, kNaN, st_.noise_N(c), st_.noise_threshold(c));
-    }
-    // A jump the check no longer holds (withdrawn as the first samples of a noise rise) is
-    // no source of this condition either.
-    if ((sens_[c].cond.sources & kJump) && !jump_[c].jump_raised()) {
-      set_condition(sensor, kJump, false, FaultKind::kBias, s.t,
-                    std::string(name) + "jump withdrawn", out);
-    }
+}
+
+void Isolator::apply_jump_verdict(int c, const JumpVerdict& v, const Vec2& e, double t,
+                                  std::vector<Detection>* out) {
+  const Sensor sensor = channel_sensor(c);
+  const std::string name = c == kV ? "accelerometer channel v: " : "gyro channel r: ";
+  // The detection just emitted (if any) gets the check's onset, statistic and confidence.
+  const auto patch = [&](std::size_t before, double onset, double stat, double thr) {
+    if (out->size() == before || !out->back().active) return;
+    Detection& d = out->back();
+    if (std::isfinite(onset)) d.onset_time = onset;
+    d.statistic = stat;
+    d.threshold = thr;
+    const Vec2 ec = stat > 0 && e.norm() > 0 ? e : (c == kV ? Vec2(1, 0) : Vec2(0, 1));
+    d.c_a = ec(0) / ec.norm();
+    d.c_g = ec(1) / ec.norm();
+  };
+  if (v.step == JumpVerdict::Change::kRaise) chan_[c].jump_at = t;
+  if (v.noise == JumpVerdict::Change::kRaise && sens_[c].cond.active &&
+      sens_[c].cond.kind == FaultKind::kBias &&
+      t - chan_[c].jump_at <= 2.0 * p_.jump.noise_window) {
+    jump_was_noise(c, name + v.message, t, out);
+    return;
   }
+  if (v.step != JumpVerdict::Change::kNone) {
+    const std::size_t before = out->size();
+    set_condition(sensor, kJump, v.step == JumpVerdict::Change::kRaise, FaultKind::kBias, t,
+                  name + v.message, out);
+    patch(before, v.onset, st_.jump_T(c), st_.jump_threshold(c));
+  }
+  if ((sens_[c].cond.sources & kJump) && model_live()) hand_jump_to_observers(c, name, t, out);
+  if (v.noise != JumpVerdict::Change::kNone) {
+    const std::size_t before = out->size();
+    set_condition(sensor, kNoiseRise, v.noise == JumpVerdict::Change::kRaise, FaultKind::kNoise, t,
+                  name + v.message, out);
+    patch(before, kNaN, st_.noise_N(c), st_.noise_threshold(c));
+  }
+  // A jump the check no longer holds (withdrawn as the first samples of a noise rise) is
+  // no source of this condition either.
+  if ((sens_[c].cond.sources & kJump) && !jump_[c].jump_raised()) {
+    set_condition(sensor, kJump, false, FaultKind::kBias, t, name + "jump withdrawn", out);
+  }
+}
+
+void Isolator::jump_was_noise(int c, const std::string& message, double t,
+                              std::vector<Detection>* out) {
+  // The jump raised just before was the first samples of a noise rise: one condition, its
+  // kind refined.
+  const Sensor sensor = channel_sensor(c);
+  set_condition(sensor, kNoiseRise, true, FaultKind::kNoise, t, message, out);
+  set_condition(sensor, kJump, false, FaultKind::kBias, t, message, out);
+  jump_[c].release();
+  Condition& cd = sens_[c].cond;
+  if (cd.active && cd.kind != FaultKind::kNoise) {
+    Detection d = make_detection(sensor, true, FaultKind::kNoise, t);
+    d.update = true;
+    d.message = std::string("kind refined from ") + to_string(cd.kind) + " to noise: " + message;
+    cd.kind = FaultKind::kNoise;
+    out->push_back(d);
+  }
+}
+
+void Isolator::hand_jump_to_observers(int c, const std::string& name, double t,
+                                      std::vector<Detection>* out) {
+  // Once the observers are live they hold a jump like any residual fault (their cross
+  // residual sees whether the offset is still there, or has gone without a jump back).
+  const Sensor sensor = channel_sensor(c);
+  const bool held = sens_[c].cond.sources & kResidual;  // the observers hold it already
+  set_condition(sensor, kResidual, true, FaultKind::kBias, t, name + "held by the observers", out);
+  set_condition(sensor, kJump, false, FaultKind::kBias, t, "", out);
+  if (!held) {
+    sens_[c].raised_at = t;
+    sens_[c].below_since = kNaN;
+    // Its kind is refined from the residuals' shape like any other (a scale error jumps).
+    if (sens_[c].cond.kind == FaultKind::kBias) chan_[c].refine_at = t + 0.5 * p_.classify_window;
+  }
+  jump_[c].release();
 }
 
 void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok) {

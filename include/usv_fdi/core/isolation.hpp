@@ -292,6 +292,16 @@ class Isolator {
   void sensor_checks(const Sample& s, std::vector<Detection>* out);
   /// The jump check of both channels (model-free: runs armed or not).
   void jump_checks(const Sample& s, std::vector<Detection>* out);
+  /// Each channel's check on one sample; their statistics into the status.
+  void update_jump_checks(const Sample& s, JumpVerdict verdict[2]);
+  /// A channel's verdict turned into conditions; e: both channels' excess evidence.
+  void apply_jump_verdict(int c, const JumpVerdict& v, const Vec2& e, double t,
+                          std::vector<Detection>* out);
+  /// The jump raised just before a noise rise was its first samples: one noise condition.
+  void jump_was_noise(int c, const std::string& message, double t, std::vector<Detection>* out);
+  /// The observers, live, take over a jump's condition.
+  void hand_jump_to_observers(int c, const std::string& name, double t,
+                              std::vector<Detection>* out);
   /// The observers are designed, settled and have learned their statistics.
   bool model_live() const;
   /// The observers' residuals, one sample: a short sequence of the steps below.
