@@ -1,4 +1,4 @@
-// The sensor-level checks (core/sensor_checks.hpp, docs/design.md section 8.4): stale,
+// The sensor-level checks (core/sensor_checks.hpp, docs/design.md section 8.3): stale,
 // stuck (with the channel's learned quantisation), invalid, and timing errors.
 #include <gtest/gtest.h>
 

@@ -342,10 +342,8 @@ class Isolator {
                          std::vector<Detection>* out);
   void refine_kinds(double t, std::vector<Detection>* out);
   void hold_or_clear(double t, const Levels& lv, int candidate, std::vector<Detection>* out);
+  /// The fault kind of a channel from its histories (core/fault_kind.hpp).
   FaultKind classify(int ch) const;
-  FaultKind classify_shape(int ch) const;
-  bool noise_like(int ch, double t_raise) const;
-  double onset_estimate(int ch, double t) const;
   std::size_t window_samples(double dt) const;
   double learned_threshold(std::vector<double>* healthy) const;
 

@@ -3,7 +3,7 @@
 // repeated for longer than its quantisation makes probable) or invalid (non-finite or
 // absurd values, invalid_count of them within spike_window); and the timing errors (stamps
 // that repeat, go backwards or jump), which count against no channel. They need no model.
-// docs/design.md section 8.4.
+// docs/design.md section 8.3.
 #pragma once
 
 #include <array>
