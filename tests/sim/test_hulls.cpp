@@ -250,6 +250,56 @@ TEST(Manoeuvre, Kvlcc2TurnsLikeThePublishedMmgStandardModel) {
   EXPECT_NEAR(tc.tactical_diameter / L, 3.36, 0.10 * 3.36);
 }
 
+TEST(Manoeuvre, TurnsAndZigzagsTakeASideStarboardByDefault) {
+  for (const std::string name : {"lcontainer", "mariner-linear", "kvlcc2"}) {
+    const Hull& h = hull(name);
+    const double U = h.nominal_speed(), L = h.limits().length;
+    const double rudder = (name == "kvlcc2" ? 35 : 10) * kDeg;
+    // The default is starboard, bit for bit.
+    const TurningCircle def = turning_circle(h, U, rudder);
+    const TurningCircle stb = turning_circle(h, U, rudder, Side::kStarboard);
+    const TurningCircle port = turning_circle(h, U, rudder, Side::kPort);
+    EXPECT_EQ(def.advance, stb.advance) << name;
+    EXPECT_EQ(def.transfer, stb.transfer) << name;
+    EXPECT_EQ(def.tactical_diameter, stb.tactical_diameter) << name;
+    EXPECT_EQ(def.steady_yaw_rate, stb.steady_yaw_rate) << name;
+    const Zigzag zdef = zigzag(h, U, 10 * kDeg, 10 * kDeg);
+    const Zigzag zstb = zigzag(h, U, 10 * kDeg, 10 * kDeg, Side::kStarboard);
+    const Zigzag zport = zigzag(h, U, 10 * kDeg, 10 * kDeg, Side::kPort);
+    EXPECT_EQ(zdef.first_overshoot, zstb.first_overshoot) << name;
+    EXPECT_EQ(zdef.second_overshoot, zstb.second_overshoot) << name;
+    // A port circle is measured towards port: positive distances, a negative yaw rate.
+    EXPECT_GT(port.advance, 0.0) << name;
+    EXPECT_GT(port.transfer, 0.0) << name;
+    EXPECT_GT(port.tactical_diameter, 0.0) << name;
+    EXPECT_LT(port.steady_yaw_rate, 0.0) << name;
+    EXPECT_GT(zport.first_overshoot, 0.0) << name;
+    EXPECT_GT(zport.second_overshoot, 0.0) << name;
+    if (!h.nonlinear()) {
+      // A linear hull is symmetric: port is starboard mirrored.
+      EXPECT_NEAR(port.advance, stb.advance, 1e-9 * L) << name;
+      EXPECT_NEAR(port.transfer, stb.transfer, 1e-9 * L) << name;
+      EXPECT_NEAR(port.tactical_diameter, stb.tactical_diameter, 1e-9 * L) << name;
+      EXPECT_NEAR(port.steady_yaw_rate, -stb.steady_yaw_rate, 1e-12) << name;
+      EXPECT_NEAR(zport.first_overshoot, zstb.first_overshoot, 1e-9) << name;
+      EXPECT_NEAR(zport.second_overshoot, zstb.second_overshoot, 1e-9) << name;
+    } else {
+      // The KVLCC2's published model is not (propeller wake and flow straightening switch
+      // with the side): its port circle differs.
+      EXPECT_GT(std::abs(port.tactical_diameter - stb.tactical_diameter), 0.01 * L) << name;
+    }
+  }
+  EXPECT_STREQ(to_string(Side::kPort), "port");
+  EXPECT_STREQ(to_string(Side::kStarboard), "starboard");
+  Side s = Side::kStarboard;
+  EXPECT_TRUE(parse_side("port", &s));
+  EXPECT_EQ(s, Side::kPort);
+  EXPECT_TRUE(parse_side("starboard", &s));
+  EXPECT_EQ(s, Side::kStarboard);
+  EXPECT_FALSE(parse_side("left", &s));
+  EXPECT_EQ(s, Side::kStarboard);
+}
+
 TEST(Manoeuvre, NonlinearHullsLoseSpeedInATurn) {
   for (const ZooEntry& e : zoo()) {
     if (!e.hull->nonlinear()) continue;

@@ -219,6 +219,58 @@ TEST(Voyage, TurningCirclesTurnFullCirclesAndResumeTheCourse) {
   }
 }
 
+TEST(Voyage, ZigzagsAndTurningCirclesTakeASideStarboardByDefault) {
+  // GIVEN every scenario's legs by default, to starboard and to port
+  const auto h = hull("mariner-linear");
+  for (const std::string& sc : scenario_names()) {
+    const auto def = scenario_legs(sc, *h);
+    const auto stb = scenario_legs(sc, *h, Side::kStarboard);
+    const auto port = scenario_legs(sc, *h, Side::kPort);
+    ASSERT_EQ(def.size(), stb.size()) << sc;
+    ASSERT_EQ(port.size(), stb.size()) << sc;
+    for (std::size_t i = 0; i < stb.size(); ++i) {
+      // THEN the default is starboard, bit for bit
+      EXPECT_EQ(def[i].kind, stb[i].kind) << sc << " " << i;
+      EXPECT_EQ(def[i].duration, stb[i].duration) << sc << " " << i;
+      EXPECT_EQ(def[i].heading, stb[i].heading) << sc << " " << i;
+      EXPECT_EQ(def[i].rudder, stb[i].rudder) << sc << " " << i;
+      EXPECT_EQ(def[i].throttle, stb[i].throttle) << sc << " " << i;
+      // and port mirrors the zigzags' and turns' rudder (and the turns' heading) only
+      const bool zig = stb[i].kind == Manoeuvre::kZigzag, turn = stb[i].kind == Manoeuvre::kTurn;
+      EXPECT_EQ(port[i].kind, stb[i].kind) << sc << " " << i;
+      EXPECT_EQ(port[i].duration, stb[i].duration) << sc << " " << i;
+      EXPECT_EQ(port[i].throttle, stb[i].throttle) << sc << " " << i;
+      EXPECT_EQ(port[i].rudder, zig || turn ? -stb[i].rudder : stb[i].rudder) << sc << " " << i;
+      EXPECT_EQ(port[i].heading, turn ? -stb[i].heading : stb[i].heading) << sc << " " << i;
+    }
+  }
+  // GIVEN a zigzag and the turns to port first, on a ship and on the Otter
+  for (const std::string name : {"mariner-linear", "otter"}) {
+    const auto hl = hull(name);
+    for (const std::string sc : {"zigzag10", "turn"}) {
+      VoyageConfig c = base(*hl, sc, 4 * leg_period(*hl));
+      const auto stb_rows = run_voyage(hl, c);
+      c.legs = scenario_legs(sc, *hl, Side::kPort);
+      const auto port_rows = run_voyage(hl, c);
+      const Manoeuvre m = sc == "turn" ? Manoeuvre::kTurn : Manoeuvre::kZigzag;
+      const auto legs = legs_of(port_rows, m);
+      ASSERT_FALSE(legs.empty()) << name << " " << sc;
+      const std::size_t i0 = legs[0].first;
+      // THEN the first rudder command is the starboard one mirrored, and the heading first
+      // leaves the base course to port
+      EXPECT_NE(port_rows[i0].delta_cmd, 0.0) << name << " " << sc;
+      EXPECT_EQ(port_rows[i0].delta_cmd, -stb_rows[i0].delta_cmd) << name << " " << sc;
+      const double base_psi = port_rows[i0].psi_meas;
+      double first_dev = 0.0;
+      for (std::size_t i = i0; i < legs[0].second && first_dev == 0.0; ++i) {
+        const double dev = port_rows[i].psi - base_psi;
+        if (std::abs(dev) > 5 * kDeg) first_dev = dev;
+      }
+      EXPECT_LT(first_dev, 0.0) << name << " " << sc;
+    }
+  }
+}
+
 TEST(Voyage, SpeedChangesChangeTheSurgeSpeed) {
   for (const std::string name : {"mariner-linear", "otter"}) {
     // GIVEN throttle steps 0.7, 1.0, 1.3, 1.0, each held for 3 leg periods
