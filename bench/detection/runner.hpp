@@ -85,6 +85,18 @@ struct RecordedRun {
   std::vector<Sample> samples;
 };
 std::vector<RecordedRun> load_hsva(const std::string& dir);
+/// What the detectors are given for the HSVA runs. B comes from dir/kvlcc2_model.yaml, read
+/// by the engine's own loader (io::load_engine_config) exactly as a user's `--config` would
+/// be; A_ref is the oracle's A: the MMG linearisation that the directory's README.md gives
+/// beside that B (Yasukawa & Yoshimura 2015 at model scale, A ~ [[-0.103, -0.412],
+/// [-0.090, -0.394]]).
+struct HsvaModel {
+  Vec2 B = Vec2::Zero();
+  Mat2 A_ref = Mat2::Zero();
+};
+/// Throws io::ConfigError, naming the file, when dir/kvlcc2_model.yaml is missing or is not
+/// a valid engine configuration.
+HsvaModel load_hsva_model(const std::string& dir);
 /// The runs one after another: each starts gap seconds after the previous one's last sample.
 std::vector<Sample> concatenate(const std::vector<RecordedRun>& runs, double gap,
                                 std::vector<double>* run_starts = nullptr);

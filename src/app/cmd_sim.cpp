@@ -114,8 +114,8 @@ bool classic_vessel(const SimArgs& a, VesselModel* vessel) {
   }
   if (a.voyage.any()) {
     spdlog::error(
-        "--sea-state, --current, --wind, --sensor, --fault-set, --fault-sigma and "
-        "--dither need a voyage scenario (course, zigzag10, zigzag20, turn, speed, "
+        "--sea-state, --current, --wind, --sensor, --fault-set, --fault-sigma, --dither "
+        "and --side need a voyage scenario (course, zigzag10, zigzag20, turn, speed, "
         "slow, voyage, hold), not '{}'",
         a.scenario);
     return false;

@@ -132,8 +132,13 @@ bool build(const VoyageCommon& c, const VoyageArgs& a, const sim::Hull& hull,
            sim::VoyageConfig* cfg, std::string* why) {
   cfg->rate_hz = c.rate_hz;
   cfg->seed = c.seed;
+  sim::Side first = sim::Side::kStarboard;
+  if (!a.side.empty() && !sim::parse_side(a.side, &first)) {
+    *why = "--side '" + a.side + "': expected starboard or port";
+    return false;
+  }
   try {
-    cfg->legs = sim::scenario_legs(c.scenario, hull);
+    cfg->legs = sim::scenario_legs(c.scenario, hull, first);
   } catch (const std::invalid_argument& e) {
     *why = e.what();
     return false;
@@ -162,7 +167,7 @@ bool build(const VoyageCommon& c, const VoyageArgs& a, const sim::Hull& hull,
 
 bool VoyageArgs::any() const {
   return sea_state || wave_period || !current.empty() || !wind.empty() || !sensor.empty() ||
-         !fault_set.empty() || !sigma_faults.empty() || !dither.empty();
+         !fault_set.empty() || !sigma_faults.empty() || !dither.empty() || !side.empty();
 }
 
 std::vector<std::string> voyage_vessel_names() { return sim::voyage_hull_names(); }
@@ -196,6 +201,9 @@ void add_voyage_options(CLI::App* sub, VoyageArgs* a) {
                   "voyages: a fault like --fault with its magnitude in units of the channel's "
                   "sigma (scale: relative); repeatable");
   sub->add_option("--dither", a->dither, "voyages: rudder dither DEG[:PERIOD_S] (a sine)");
+  sub->add_option("--side", a->side,
+                  "voyages: side of the first zigzag execute and of the first turning circle "
+                  "(starboard, default, or port)");
 }
 
 int run_voyage_sim(const VoyageCommon& c, const VoyageArgs& a) {

@@ -24,6 +24,7 @@ struct VoyageArgs {
   std::string fault_set;
   std::vector<std::string> sigma_faults;
   std::string dither;  ///< DEG[:PERIOD]
+  std::string side;    ///< first side of zigzags and turning circles (empty: starboard)
   /// True when any voyage-only option was given (an error with a classic scenario).
   bool any() const;
 };

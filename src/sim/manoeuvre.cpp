@@ -74,28 +74,37 @@ ManoeuvreState manoeuvre_step(const Hull& hull, const ManoeuvreState& s, double 
   return advance(s, sum, dt / 6);
 }
 
+const char* to_string(Side side) { return side == Side::kPort ? "port" : "starboard"; }
+
+bool parse_side(const std::string& text, Side* side) {
+  if (text != "starboard" && text != "port") return false;
+  *side = text == "port" ? Side::kPort : Side::kStarboard;
+  return true;
+}
+
 double starboard_rudder_sign(const Hull& hull, double u0) {
   return linearise(hull, u0).B(1) > 0.0 ? 1.0 : -1.0;
 }
 
-TurningCircle turning_circle(const Hull& hull, double u0, double rudder, double dt) {
+TurningCircle turning_circle(const Hull& hull, double u0, double rudder, Side side, double dt) {
   check_step(dt);
   const double throttle = equilibrium_throttle(hull, u0);
-  const double dc = starboard_rudder_sign(hull, u0) * std::abs(rudder);
+  const double k = side_sign(side);  // heading and east mirrored for a port turn
+  const double dc = k * starboard_rudder_sign(hull, u0) * std::abs(rudder);
   TurningCircle tc;
   tc.approach_speed = u0;
   ManoeuvreState s = straight(u0);
   const double t_max = 2000.0 * hull.limits().length / u0;  // bounds a hull that never turns
   bool at90 = false, at180 = false;
-  for (double t = 0.0; t < t_max && s.psi < 4 * M_PI; t += dt) {
+  for (double t = 0.0; t < t_max && k * s.psi < 4 * M_PI; t += dt) {
     s = manoeuvre_step(hull, s, dc, throttle, dt);
-    if (!at90 && s.psi >= M_PI / 2) {
+    if (!at90 && k * s.psi >= M_PI / 2) {
       tc.advance = s.north;
-      tc.transfer = s.east;
+      tc.transfer = k * s.east;
       at90 = true;
     }
-    if (!at180 && s.psi >= M_PI) {
-      tc.tactical_diameter = s.east;
+    if (!at180 && k * s.psi >= M_PI) {
+      tc.tactical_diameter = k * s.east;
       at180 = true;
     }
   }
@@ -105,30 +114,40 @@ TurningCircle turning_circle(const Hull& hull, double u0, double rudder, double 
   return tc;
 }
 
-Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, double dt) {
+Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, Side first, double dt) {
   check_step(dt);
   const double throttle = equilibrium_throttle(hull, u0);
-  const double sign = starboard_rudder_sign(hull, u0);
+  const double k = side_sign(first);  // the heading mirrored when the first execute is to port
+  const double sign = k * starboard_rudder_sign(hull, u0);
   ManoeuvreState s = straight(u0);
   Zigzag z;
   int executes = 0;      // rudder reversals so far
-  double side = 1.0;     // +1: rudder to starboard, heading going starboard
-  double extreme = 0.0;  // extreme heading since the last execute
+  double side = 1.0;     // +1: rudder to the first side, heading going that way
+  double extreme = 0.0;  // extreme (mirrored) heading since the last execute
   const double t_max = 500.0 * hull.limits().length / u0;
   for (double t = 0.0; t < t_max && executes < 3; t += dt) {
     s = manoeuvre_step(hull, s, sign * side * std::abs(rudder), throttle, dt);
-    if (executes >= 1) extreme = side < 0 ? std::max(extreme, s.psi) : std::min(extreme, s.psi);
-    if (side * s.psi >= std::abs(heading)) {
+    const double psi = k * s.psi;
+    if (executes >= 1) extreme = side < 0 ? std::max(extreme, psi) : std::min(extreme, psi);
+    if (side * psi >= std::abs(heading)) {
       if (executes == 1) z.first_overshoot = extreme - std::abs(heading);
       if (executes == 2) z.second_overshoot = -extreme - std::abs(heading);
       if (executes == 1) z.time_to_second_execute = t;
       side = -side;
-      extreme = s.psi;
+      extreme = psi;
       ++executes;
     }
   }
   if (executes < 3) throw std::runtime_error("zigzag: '" + hull.name() + "' did not complete");
   return z;
+}
+
+TurningCircle turning_circle(const Hull& hull, double u0, double rudder, double dt) {
+  return turning_circle(hull, u0, rudder, Side::kStarboard, dt);
+}
+
+Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, double dt) {
+  return zigzag(hull, u0, rudder, heading, Side::kStarboard, dt);
 }
 
 }  // namespace usvfdi::sim

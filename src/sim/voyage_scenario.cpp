@@ -30,17 +30,19 @@ void course_changes(double p, double throttle, std::vector<Leg>* out) {
   }
 }
 
-void zigzag(double p, double angle, std::vector<Leg>* out) {
+/// A zigzag whose first execute is to side k (+1 starboard, -1 port: the sign of the rudder).
+void zigzag(double p, double angle, double k, std::vector<Leg>* out) {
   out->push_back(leg(Manoeuvre::kHold, p));
-  out->push_back(leg(Manoeuvre::kZigzag, 8.0 * p, angle * kDeg, angle * kDeg));
+  out->push_back(leg(Manoeuvre::kZigzag, 8.0 * p, angle * kDeg, k * (angle * kDeg)));
   out->push_back(leg(Manoeuvre::kHold, 2.0 * p));
 }
 
-void turns(double p, double rudder, std::vector<Leg>* out) {
+/// A turning circle to side k (+1 starboard, -1 port), then one to the other side.
+void turns(double p, double rudder, double k, std::vector<Leg>* out) {
   out->push_back(leg(Manoeuvre::kHold, p));
-  out->push_back(leg(Manoeuvre::kTurn, 20.0 * p, 360.0 * kDeg, rudder));
+  out->push_back(leg(Manoeuvre::kTurn, 20.0 * p, k * (360.0 * kDeg), k * rudder));
   out->push_back(leg(Manoeuvre::kHold, 2.0 * p));
-  out->push_back(leg(Manoeuvre::kTurn, 20.0 * p, -360.0 * kDeg, -rudder));
+  out->push_back(leg(Manoeuvre::kTurn, 20.0 * p, -k * (360.0 * kDeg), -k * rudder));
   out->push_back(leg(Manoeuvre::kHold, 2.0 * p));
 }
 
@@ -101,9 +103,10 @@ std::vector<std::string> scenario_names() {
   return {"hold", "course", "zigzag10", "zigzag20", "turn", "speed", "slow", "voyage"};
 }
 
-std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull) {
+std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull, Side first) {
   const double p = leg_period(hull);
   const double turn_rudder = turning_rudder(hull);
+  const double k = side_sign(first);
   std::vector<Leg> out;
   if (name == "hold") {
     out.push_back(leg(Manoeuvre::kHold, p));
@@ -111,9 +114,9 @@ std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull) {
     out.push_back(leg(Manoeuvre::kHold, p));
     course_changes(p, -1.0, &out);
   } else if (name == "zigzag10" || name == "zigzag20") {
-    zigzag(p, name == "zigzag10" ? 10.0 : 20.0, &out);
+    zigzag(p, name == "zigzag10" ? 10.0 : 20.0, k, &out);
   } else if (name == "turn") {
-    turns(p, turn_rudder, &out);
+    turns(p, turn_rudder, k, &out);
   } else if (name == "speed") {
     out.push_back(leg(Manoeuvre::kHold, p));
     speed_changes(p, &out);
@@ -122,10 +125,10 @@ std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull) {
   } else if (name == "voyage") {
     out.push_back(leg(Manoeuvre::kHold, p));
     course_changes(p, -1.0, &out);
-    zigzag(p, 10.0, &out);
+    zigzag(p, 10.0, k, &out);
     speed_changes(p, &out);
-    turns(p, turn_rudder, &out);
-    zigzag(p, 20.0, &out);
+    turns(p, turn_rudder, k, &out);
+    zigzag(p, 20.0, k, &out);
     slow_passage(p, &out);
   } else {
     std::string names;

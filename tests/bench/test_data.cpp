@@ -1,12 +1,20 @@
 // The benchmark's data: fault injection on recorded samples, the standard fault set, and the
-// HSVA KVLCC2 tests read from shared/realdata beside the repository (skipped, saying why,
-// where they are missing).
+// HSVA KVLCC2 tests and their model (B from the data's kvlcc2_model.yaml through the engine's
+// config loader) read from shared/realdata beside the repository (skipped, saying why, where
+// they are missing).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <regex>
+#include <sstream>
+#include <string>
 
 #include "runner.hpp"
+#include "usv_fdi/io/config.hpp"
 
 namespace usvfdi::bench {
 namespace {
@@ -128,6 +136,118 @@ TEST_F(RealData, ThirteenRunsAt20HzOneAfterAnother) {
   EXPECT_GT(sigma(1), 0.0);
   EXPECT_LT(sigma(0), 0.005);
   EXPECT_LT(sigma(1), 0.002);
+}
+
+/// The whole text of a file ("" if unreadable).
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Every number in text, in order (U+2212 minus signs read as '-').
+std::vector<double> numbers_in(std::string text) {
+  for (std::size_t p; (p = text.find("\xE2\x88\x92")) != std::string::npos;) {
+    text.replace(p, 3, "-");
+  }
+  std::vector<double> out;
+  const std::regex num(R"([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), num); it != std::sregex_iterator();
+       ++it) {
+    out.push_back(std::stod(it->str()));
+  }
+  return out;
+}
+
+TEST_F(RealData, HsvaModelTakesBFromTheYamlAsAUserWouldAndAFromTheReadme) {
+  const std::string yaml = dir_ + "/kvlcc2_model.yaml";
+  const HsvaModel m = load_hsva_model(dir_);
+  // B: the two numbers of the yaml's `B: [b1, b2]` line, exactly (no copy of them in the
+  // bench code), and what a user's `usv-fdi replay --config` of that file gets.
+  std::istringstream lines(slurp(yaml));
+  std::vector<double> b;
+  for (std::string line; std::getline(lines, line);) {
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    if (line.find("B:") != std::string::npos) b = numbers_in(line.substr(line.find("B:") + 2));
+  }
+  ASSERT_EQ(b.size(), 2u) << yaml << ": no `B: [b1, b2]` line";
+  EXPECT_EQ(m.B(0), b[0]);
+  EXPECT_EQ(m.B(1), b[1]);
+  const EngineConfig user = io::load_engine_config(yaml);
+  EXPECT_EQ(m.B, user.B);
+  // delta + to port in the data: b1 > 0, b2 < 0 (README, "Signs").
+  EXPECT_GT(m.B(0), 0.0);
+  EXPECT_LT(m.B(1), 0.0);
+  // A_ref: the README's "A ~ [[a11, a12], [a21, a22]]" of the same linearisation.
+  const std::string readme = slurp(dir_ + "/README.md");
+  const auto at = readme.find("A \xE2\x89\x88 [[");
+  ASSERT_NE(at, std::string::npos) << dir_ << "/README.md: no 'A \xE2\x89\x88 [[' found";
+  const std::string text = readme.substr(at + 5, readme.find("]]", at) - at - 5);
+  const std::vector<double> a = numbers_in(text);
+  ASSERT_EQ(a.size(), 4u) << text;
+  EXPECT_EQ(m.A_ref(0, 0), a[0]);
+  EXPECT_EQ(m.A_ref(0, 1), a[1]);
+  EXPECT_EQ(m.A_ref(1, 0), a[2]);
+  EXPECT_EQ(m.A_ref(1, 1), a[3]);
+}
+
+/// A fresh empty directory under the system's temporary directory, removed on destruction.
+class TempDir {
+ public:
+  TempDir() {
+    path_ = std::filesystem::temp_directory_path() /
+            ("usv_fdi_hsva_model_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  std::string str() const { return path_.string(); }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(path_ / name) << text;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// The message of the io::ConfigError that f throws ("" and a failure if it throws none).
+template <class F>
+std::string config_error(F f) {
+  try {
+    f();
+  } catch (const io::ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no io::ConfigError";
+  return "";
+}
+
+TEST(BenchData, HsvaModelRefusesAMissingOrBadYamlNamingTheFile) {
+  const TempDir dir;
+  const std::string file = dir.str() + "/kvlcc2_model.yaml";
+  // missing
+  std::string why = config_error([&] { load_hsva_model(dir.str()); });
+  EXPECT_NE(why.find(file), std::string::npos) << why;
+  EXPECT_NE(why.find("cannot read"), std::string::npos) << why;
+  // B with one element
+  dir.write("kvlcc2_model.yaml", "model:\n  B: [0.0345]\n");
+  why = config_error([&] { load_hsva_model(dir.str()); });
+  EXPECT_NE(why.find(file), std::string::npos) << why;
+  EXPECT_NE(why.find("model.B"), std::string::npos) << why;
+  // no model.B
+  dir.write("kvlcc2_model.yaml", "model:\n  reference_speed: 1.179\n");
+  why = config_error([&] { load_hsva_model(dir.str()); });
+  EXPECT_NE(why.find(file), std::string::npos) << why;
+  EXPECT_NE(why.find("model.B"), std::string::npos) << why;
+  // not YAML
+  dir.write("kvlcc2_model.yaml", "model: [B: {\n");
+  why = config_error([&] { load_hsva_model(dir.str()); });
+  EXPECT_NE(why.find(file), std::string::npos) << why;
+  // and a good one is read
+  dir.write("kvlcc2_model.yaml", "model:\n  B: [0.5, -0.25]\n");
+  EXPECT_EQ(load_hsva_model(dir.str()).B, Vec2(0.5, -0.25));
 }
 
 }  // namespace

@@ -250,6 +250,103 @@ TEST(Manoeuvre, Kvlcc2TurnsLikeThePublishedMmgStandardModel) {
   EXPECT_NEAR(tc.tactical_diameter / L, 3.36, 0.10 * 3.36);
 }
 
+TEST(Manoeuvre, Kvlcc2TurnsToPortLikeThePublishedMmgStandardModel) {
+  // Yasukawa & Yoshimura 2015, Table 4, the 7 m model turning with 35 deg of rudder to PORT,
+  // calculated with the MMG standard model: advance 3.26 L, tactical diameter 3.26 L (their
+  // free-running tests: 3.11 L and 3.08 L). The port figures were not read from the paper
+  // here but from a secondary source that transcribes Table 4 (JuliaComputing/DyadShip,
+  // scripts/validate_kvlcc2.jl; its starboard figures are the 3.31 / 3.36 L above);
+  // docs/vessels.md says so. Tolerance as to starboard: 10 % of the calculated figure, about
+  // twice the paper's own calculation-to-test differences (up to 5.8 %, the port tactical
+  // diameter). Against the free-running test the same 10 % is asserted.
+  const Hull& h = hull("kvlcc2");
+  const double L = h.limits().length;
+  const TurningCircle tc = turning_circle(h, h.nominal_speed(), 35 * kDeg, Side::kPort);
+  std::printf("kvlcc2 35 deg turn to port: advance %.2f L, tactical diameter %.2f L\n",
+              tc.advance / L, tc.tactical_diameter / L);
+  EXPECT_NEAR(tc.advance / L, 3.26, 0.10 * 3.26);
+  EXPECT_NEAR(tc.tactical_diameter / L, 3.26, 0.10 * 3.26);
+  EXPECT_NEAR(tc.advance / L, 3.11, 0.10 * 3.11);
+  EXPECT_NEAR(tc.tactical_diameter / L, 3.08, 0.10 * 3.08);
+}
+
+TEST(Manoeuvre, Kvlcc2FullScaleTurnsWithin20PercentOfThePublishedFullScaleSimulation) {
+  // Yasukawa & Yoshimura 2015, Table 6: the MMG standard model at full scale (320 m, 15.5 kn)
+  // turning with 35 deg of rudder, calculated: starboard advance 3.62 L, tactical diameter
+  // 3.71 L; port 3.56 L, 3.59 L (read, like the port figures above, from the secondary
+  // source's transcription). For it the paper took a full-scale hull resistance from a 3-D
+  // extrapolation (not printed) and full-scale propulsion; `kvlcc2-full` is the published
+  // model-scale coefficients at 320 m (docs/vessels.md) and turns like the 7 m model, 14-16 %
+  // tighter than Table 6. The paper's own full-scale circles are 9-10 % wider than its model
+  // ones: 20 % (that scale effect plus the 10 % allowed at model scale) is asserted, and the
+  // deviation documented rather than tuned away.
+  const Hull& h = hull("kvlcc2-full");
+  const double L = h.limits().length;
+  const struct {
+    Side side;
+    double advance, tactical;
+  } cases[] = {{Side::kStarboard, 3.62, 3.71}, {Side::kPort, 3.56, 3.59}};
+  for (const auto& c : cases) {
+    const TurningCircle tc = turning_circle(h, h.nominal_speed(), 35 * kDeg, c.side, 0.5);
+    std::printf(
+        "kvlcc2-full 35 deg turn to %s: advance %.2f L (%.2f), tactical diameter %.2f L "
+        "(%.2f)\n",
+        to_string(c.side), tc.advance / L, c.advance, tc.tactical_diameter / L, c.tactical);
+    EXPECT_NEAR(tc.advance / L, c.advance, 0.20 * c.advance) << to_string(c.side);
+    EXPECT_NEAR(tc.tactical_diameter / L, c.tactical, 0.20 * c.tactical) << to_string(c.side);
+  }
+}
+
+TEST(Manoeuvre, TurnsAndZigzagsTakeASideStarboardByDefault) {
+  for (const std::string name : {"lcontainer", "mariner-linear", "kvlcc2"}) {
+    const Hull& h = hull(name);
+    const double U = h.nominal_speed(), L = h.limits().length;
+    const double rudder = (name == "kvlcc2" ? 35 : 10) * kDeg;
+    // The default is starboard, bit for bit.
+    const TurningCircle def = turning_circle(h, U, rudder);
+    const TurningCircle stb = turning_circle(h, U, rudder, Side::kStarboard);
+    const TurningCircle port = turning_circle(h, U, rudder, Side::kPort);
+    EXPECT_EQ(def.advance, stb.advance) << name;
+    EXPECT_EQ(def.transfer, stb.transfer) << name;
+    EXPECT_EQ(def.tactical_diameter, stb.tactical_diameter) << name;
+    EXPECT_EQ(def.steady_yaw_rate, stb.steady_yaw_rate) << name;
+    const Zigzag zdef = zigzag(h, U, 10 * kDeg, 10 * kDeg);
+    const Zigzag zstb = zigzag(h, U, 10 * kDeg, 10 * kDeg, Side::kStarboard);
+    const Zigzag zport = zigzag(h, U, 10 * kDeg, 10 * kDeg, Side::kPort);
+    EXPECT_EQ(zdef.first_overshoot, zstb.first_overshoot) << name;
+    EXPECT_EQ(zdef.second_overshoot, zstb.second_overshoot) << name;
+    // A port circle is measured towards port: positive distances, a negative yaw rate.
+    EXPECT_GT(port.advance, 0.0) << name;
+    EXPECT_GT(port.transfer, 0.0) << name;
+    EXPECT_GT(port.tactical_diameter, 0.0) << name;
+    EXPECT_LT(port.steady_yaw_rate, 0.0) << name;
+    EXPECT_GT(zport.first_overshoot, 0.0) << name;
+    EXPECT_GT(zport.second_overshoot, 0.0) << name;
+    if (!h.nonlinear()) {
+      // A linear hull is symmetric: port is starboard mirrored.
+      EXPECT_NEAR(port.advance, stb.advance, 1e-9 * L) << name;
+      EXPECT_NEAR(port.transfer, stb.transfer, 1e-9 * L) << name;
+      EXPECT_NEAR(port.tactical_diameter, stb.tactical_diameter, 1e-9 * L) << name;
+      EXPECT_NEAR(port.steady_yaw_rate, -stb.steady_yaw_rate, 1e-12) << name;
+      EXPECT_NEAR(zport.first_overshoot, zstb.first_overshoot, 1e-9) << name;
+      EXPECT_NEAR(zport.second_overshoot, zstb.second_overshoot, 1e-9) << name;
+    } else {
+      // The KVLCC2's published model is not (propeller wake and flow straightening switch
+      // with the side): its port circle differs.
+      EXPECT_GT(std::abs(port.tactical_diameter - stb.tactical_diameter), 0.01 * L) << name;
+    }
+  }
+  EXPECT_STREQ(to_string(Side::kPort), "port");
+  EXPECT_STREQ(to_string(Side::kStarboard), "starboard");
+  Side s = Side::kStarboard;
+  EXPECT_TRUE(parse_side("port", &s));
+  EXPECT_EQ(s, Side::kPort);
+  EXPECT_TRUE(parse_side("starboard", &s));
+  EXPECT_EQ(s, Side::kStarboard);
+  EXPECT_FALSE(parse_side("left", &s));
+  EXPECT_EQ(s, Side::kStarboard);
+}
+
 TEST(Manoeuvre, NonlinearHullsLoseSpeedInATurn) {
   for (const ZooEntry& e : zoo()) {
     if (!e.hull->nonlinear()) continue;
@@ -333,11 +430,12 @@ std::vector<double> recorded_heading(const std::string& path) {
   return psi;
 }
 
-/// First and second overshoot [rad] of a heading record that starts to starboard.
-std::pair<double, double> overshoots(const std::vector<double>& psi, double heading) {
+/// First and second overshoot [rad] of a heading record whose first execute is to `first`.
+std::pair<double, double> overshoots(const std::vector<double>& psi, double heading, Side first) {
   int executes = 0;
   double side = 1.0, extreme = 0.0, o1 = NAN, o2 = NAN;
-  for (double p : psi) {
+  for (double q : psi) {
+    const double p = side_sign(first) * q;  // mirrored when the first execute is to port
     if (executes >= 1) extreme = side < 0 ? std::max(extreme, p) : std::min(extreme, p);
     if (side * p >= heading) {
       if (executes == 1) o1 = extreme - heading;
@@ -356,22 +454,26 @@ TEST(Manoeuvre, Kvlcc2ZigzagsAgainstTheRecordedHsvaTests) {
     GTEST_SKIP() << "no " << dir << " (set USV_FDI_SHARED to the shared data directory)";
   }
   // The MMG model (Yasukawa & Yoshimura 2015) against HSVA's free-running 7 m model: the
-  // model under-predicts the first overshoot by 30-50 % (measured 9.7 deg in the 10/10, the
-  // model 5.0 deg), the second by up to 40 %. Asserted: within 50 % and never above the
-  // measurement by more than 15 %. The numbers are printed.
+  // model under-predicts the first overshoot by 20-50 % (measured 9.7 deg in the 10/10 to
+  // either side, the model 5.0 deg starting to starboard, 7.2 deg to port), the second by up
+  // to 40 %. Asserted: within 50 % and never above the measurement by more than 15 %. The
+  // numbers are printed. (Those tests whose name has no _P or _S start to starboard.)
   const struct {
     const char* file;
     double rudder, heading;
-  } cases[] = {{"HSVA_CPMC_KVLCC2_Z_10_10_S.csv", 10, 10},
-               {"HSVA_CPMC_KVLCC2_Z_20_10_S.csv", 20, 10},
-               {"HSVA_CPMC_KVLCC2_Z_10_05.csv", 10, 5},
-               {"HSVA_CPMC_KVLCC2_Z_20_05.csv", 20, 5}};
+    Side first;
+  } cases[] = {{"HSVA_CPMC_KVLCC2_Z_10_10_S.csv", 10, 10, Side::kStarboard},
+               {"HSVA_CPMC_KVLCC2_Z_10_10_P.csv", 10, 10, Side::kPort},
+               {"HSVA_CPMC_KVLCC2_Z_20_10_S.csv", 20, 10, Side::kStarboard},
+               {"HSVA_CPMC_KVLCC2_Z_20_10_P.csv", 20, 10, Side::kPort},
+               {"HSVA_CPMC_KVLCC2_Z_10_05.csv", 10, 5, Side::kStarboard},
+               {"HSVA_CPMC_KVLCC2_Z_20_05.csv", 20, 5, Side::kStarboard}};
   const Hull& h = hull("kvlcc2");
   for (const auto& c : cases) {
     const std::vector<double> psi = recorded_heading(dir + c.file);
     ASSERT_FALSE(psi.empty()) << c.file;
-    const auto [m1, m2] = overshoots(psi, c.heading * kDeg);
-    const Zigzag z = zigzag(h, 1.179, c.rudder * kDeg, c.heading * kDeg, 0.02);
+    const auto [m1, m2] = overshoots(psi, c.heading * kDeg, c.first);
+    const Zigzag z = zigzag(h, 1.179, c.rudder * kDeg, c.heading * kDeg, c.first, 0.02);
     std::printf("%s: recorded %.2f / %.2f deg, MMG %.2f / %.2f deg\n", c.file, m1 / kDeg, m2 / kDeg,
                 z.first_overshoot / kDeg, z.second_overshoot / kDeg);
     EXPECT_GT(z.first_overshoot, 0.5 * m1) << c.file;

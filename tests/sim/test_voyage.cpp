@@ -219,6 +219,58 @@ TEST(Voyage, TurningCirclesTurnFullCirclesAndResumeTheCourse) {
   }
 }
 
+TEST(Voyage, ZigzagsAndTurningCirclesTakeASideStarboardByDefault) {
+  // GIVEN every scenario's legs by default, to starboard and to port
+  const auto h = hull("mariner-linear");
+  for (const std::string& sc : scenario_names()) {
+    const auto def = scenario_legs(sc, *h);
+    const auto stb = scenario_legs(sc, *h, Side::kStarboard);
+    const auto port = scenario_legs(sc, *h, Side::kPort);
+    ASSERT_EQ(def.size(), stb.size()) << sc;
+    ASSERT_EQ(port.size(), stb.size()) << sc;
+    for (std::size_t i = 0; i < stb.size(); ++i) {
+      // THEN the default is starboard, bit for bit
+      EXPECT_EQ(def[i].kind, stb[i].kind) << sc << " " << i;
+      EXPECT_EQ(def[i].duration, stb[i].duration) << sc << " " << i;
+      EXPECT_EQ(def[i].heading, stb[i].heading) << sc << " " << i;
+      EXPECT_EQ(def[i].rudder, stb[i].rudder) << sc << " " << i;
+      EXPECT_EQ(def[i].throttle, stb[i].throttle) << sc << " " << i;
+      // and port mirrors the zigzags' and turns' rudder (and the turns' heading) only
+      const bool zig = stb[i].kind == Manoeuvre::kZigzag, turn = stb[i].kind == Manoeuvre::kTurn;
+      EXPECT_EQ(port[i].kind, stb[i].kind) << sc << " " << i;
+      EXPECT_EQ(port[i].duration, stb[i].duration) << sc << " " << i;
+      EXPECT_EQ(port[i].throttle, stb[i].throttle) << sc << " " << i;
+      EXPECT_EQ(port[i].rudder, zig || turn ? -stb[i].rudder : stb[i].rudder) << sc << " " << i;
+      EXPECT_EQ(port[i].heading, turn ? -stb[i].heading : stb[i].heading) << sc << " " << i;
+    }
+  }
+  // GIVEN a zigzag and the turns to port first, on a ship and on the Otter
+  for (const std::string name : {"mariner-linear", "otter"}) {
+    const auto hl = hull(name);
+    for (const std::string sc : {"zigzag10", "turn"}) {
+      VoyageConfig c = base(*hl, sc, 4 * leg_period(*hl));
+      const auto stb_rows = run_voyage(hl, c);
+      c.legs = scenario_legs(sc, *hl, Side::kPort);
+      const auto port_rows = run_voyage(hl, c);
+      const Manoeuvre m = sc == "turn" ? Manoeuvre::kTurn : Manoeuvre::kZigzag;
+      const auto legs = legs_of(port_rows, m);
+      ASSERT_FALSE(legs.empty()) << name << " " << sc;
+      const std::size_t i0 = legs[0].first;
+      // THEN the first rudder command is the starboard one mirrored, and the heading first
+      // leaves the base course to port
+      EXPECT_NE(port_rows[i0].delta_cmd, 0.0) << name << " " << sc;
+      EXPECT_EQ(port_rows[i0].delta_cmd, -stb_rows[i0].delta_cmd) << name << " " << sc;
+      const double base_psi = port_rows[i0].psi_meas;
+      double first_dev = 0.0;
+      for (std::size_t i = i0; i < legs[0].second && first_dev == 0.0; ++i) {
+        const double dev = port_rows[i].psi - base_psi;
+        if (std::abs(dev) > 5 * kDeg) first_dev = dev;
+      }
+      EXPECT_LT(first_dev, 0.0) << name << " " << sc;
+    }
+  }
+}
+
 TEST(Voyage, SpeedChangesChangeTheSurgeSpeed) {
   for (const std::string name : {"mariner-linear", "otter"}) {
     // GIVEN throttle steps 0.7, 1.0, 1.3, 1.0, each held for 3 leg periods
@@ -275,6 +327,72 @@ TEST(Voyage, RudderIsSaturatedAndRateLimited) {
     EXPECT_LE(std::abs(rows[i].delta_true), l.max_rudder + 1e-12);
     EXPECT_LE(std::abs(rows[i].delta_true - rows[i - 1].delta_true),
               l.max_rudder_rate / c.rate_hz + 1e-12);
+  }
+}
+
+/// A voyage of one turning leg from t = 0 with rudder `rudder` (a step of the command at
+/// t = 0; the leg turns by at most 360 deg, far more than the run lasts), calm water, no sensor
+/// noise, sampled at 20 samples per servo time constant for `duration` [s].
+std::vector<VoyageRow> rudder_step(const std::shared_ptr<const Hull>& h, double rudder,
+                                   double duration) {
+  VoyageConfig c;
+  c.rate_hz = 20.0 / h->limits().rudder_time_constant;
+  c.duration = duration;
+  sensor_preset("ideal", 0, 0, &c.sensors);
+  Leg turn;
+  turn.kind = Manoeuvre::kTurn;
+  turn.duration = 10 * duration;
+  turn.heading = 2 * M_PI;
+  turn.rudder = rudder;
+  c.legs = {turn};
+  return run_voyage(h, c);
+}
+
+TEST(Voyage, RudderFollowsAStepOfTheCommandThroughTheServoLag) {
+  for (const std::string& name : voyage_hull_names()) {
+    // GIVEN a step of the rudder command small enough that the servo is not rate-limited
+    // (initial rate X / T = half the rate limit)
+    const auto h = hull(name);
+    const HullLimits l = h->limits();
+    const double T = l.rudder_time_constant;
+    const double X = std::min(0.5 * l.max_rudder_rate * T, 0.5 * l.max_rudder);
+    const auto rows = rudder_step(h, X, 5 * T);
+    ASSERT_GE(rows.size(), 100u) << name;
+    // THEN the rudder is the first-order lag of the step, X (1 - exp(-t / T)): 63.2 % of it
+    // after one time constant, 95 % after three; on the side of the command, never beyond it
+    for (const VoyageRow& w : rows) {
+      ASSERT_NEAR(std::abs(w.delta_cmd), X, 1e-12) << name << " t=" << w.t_true;
+      EXPECT_GE(w.delta_true * w.delta_cmd, 0.0) << name << " t=" << w.t_true;
+      EXPECT_NEAR(std::abs(w.delta_true), X * -std::expm1(-w.t_true / T), 1e-6 * X)
+          << name << " t=" << w.t_true;
+    }
+    EXPECT_NEAR(std::abs(rows[20].delta_true) / X, 0.632, 0.001) << name;  // t = T
+    EXPECT_NEAR(std::abs(rows[60].delta_true) / X, 0.950, 0.001) << name;  // t = 3 T
+  }
+}
+
+TEST(Voyage, RudderStepBeyondTheLimitIsRateLimitedThenLagsIntoTheSaturation) {
+  for (const std::string& name : voyage_hull_names()) {
+    // GIVEN a command of twice the rudder limit M
+    const auto h = hull(name);
+    const HullLimits l = h->limits();
+    const double M = l.max_rudder, rate = l.max_rudder_rate, T = l.rudder_time_constant;
+    // THEN the command is saturated at M; the rudder moves at the rate limit until the lag's
+    // rate (M - delta) / T falls below it (delta = M - rate T, at t1), then lags into M:
+    // delta = rate t before t1, M - rate T exp(-(t - t1) / T) after; it never exceeds M
+    const double t1 = std::max(0.0, (M - rate * T) / rate);
+    const auto expected = [&](double t) {
+      if (t1 == 0.0) return M * -std::expm1(-t / T);
+      return t <= t1 ? rate * t : M - rate * T * std::exp(-(t - t1) / T);
+    };
+    const auto rows = rudder_step(h, 2 * M, t1 + 6 * T);
+    for (const VoyageRow& w : rows) {
+      ASSERT_NEAR(std::abs(w.delta_cmd), M, 1e-12) << name << " t=" << w.t_true;
+      EXPECT_LE(std::abs(w.delta_true), M) << name << " t=" << w.t_true;
+      EXPECT_NEAR(std::abs(w.delta_true), expected(w.t_true), 1e-5 * M)
+          << name << " t=" << w.t_true;
+    }
+    EXPECT_NEAR(std::abs(rows.back().delta_true), M, 0.01 * rate * T) << name;
   }
 }
 

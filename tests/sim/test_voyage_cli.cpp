@@ -80,6 +80,8 @@ TEST_F(VoyageCli, BadVoyageOptionsAreNamed) {
       {"--scenario course --steering sine", "--steering applies to the classic scenarios"},
       {"--scenario course --wave-period 8", "--wave-period needs a --sea-state"},
       {"--scenario course --fault-sigma gyro:bogus:1:2:3", "unknown kind 'bogus'"},
+      {"--scenario zigzag10 --side left", "--side"},
+      {"--scenario paper --side port", "need a voyage scenario"},
   };
   const Outcome zoo = run("sim --vessel container --scenario paper" + out);
   EXPECT_EQ(zoo.code, 64);

@@ -22,6 +22,7 @@
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/types.hpp"
 #include "usv_fdi/sim/hull.hpp"
+#include "usv_fdi/sim/manoeuvre.hpp"
 
 namespace usvfdi::sim {
 
@@ -47,12 +48,14 @@ struct Leg {
 /// Names of the voyage scenarios, for `--scenario` and errors.
 std::vector<std::string> scenario_names();
 /// The legs of a named scenario for a hull (periods scaled by its length and speed).
-/// course: +-10 deg course changes; zigzag10 / zigzag20: 10/10 and 20/20 zigzags;
-/// turn: starboard and port turning circles; speed: throttle steps of -30 % and +30 %
-/// (deceleration and acceleration) under course changes; slow: a slow passage at 50 %
-/// throttle with course changes; voyage: all of them, one after another.
+/// course: +-10 deg course changes; zigzag10 / zigzag20: 10/10 and 20/20 zigzags, the first
+/// execute to `first`; turn: a turning circle to `first`, then one to the other side; speed:
+/// throttle steps of -30 % and +30 % (deceleration and acceleration) under course changes;
+/// slow: a slow passage at 50 % throttle with course changes; voyage: all of them, one after
+/// another. `first` defaults to starboard (the legs are then those of before it existed).
 /// Throws std::invalid_argument on an unknown name.
-std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull);
+std::vector<Leg> scenario_legs(const std::string& name, const Hull& hull,
+                               Side first = Side::kStarboard);
 /// Time between course changes of the scripted voyages: max(20 s, 6 L / U0).
 double leg_period(const Hull& hull);
 /// Rudder of the turning circles: 35 deg (or the hull's maximum); on a linear hull, whose
