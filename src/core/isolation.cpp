@@ -210,24 +210,25 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
   for (int c = 0; c < 2; ++c) {  // the rudder is not an INS sensor: it pauses FDI (status flag)
     const SensorChecks::Verdict& v = checks_.verdict(c);
     const Sensor sensor = channel_sensor(c);
-    const std::string name = c == kV ? "accelerometer channel v" : "gyro channel r";
+    const char* name = c == kV ? "accelerometer channel v" : "gyro channel r";
     const unsigned src = sens_[c].cond.sources;
     if (v.stale != static_cast<bool>(src & kStale)) {
       set_condition(sensor, kStale, v.stale, FaultKind::kStale, s.t,
-                    name + (v.stale ? ": no valid value for " + std::to_string(v.since_valid) + " s"
-                                    : ": valid values again"),
+                    std::string(name) +
+                        (v.stale ? ": no valid value for " + std::to_string(v.since_valid) + " s"
+                                 : ": valid values again"),
                     out);
     }
     if (v.stuck != static_cast<bool>(src & kStuck)) {
       set_condition(sensor, kStuck, v.stuck, FaultKind::kStuck, s.t,
-                    name + (v.stuck ? ": output frozen at " + std::to_string(v.value)
-                                    : ": output moves again"),
+                    std::string(name) + (v.stuck ? ": output frozen at " + std::to_string(v.value)
+                                                 : ": output moves again"),
                     out);
     }
     if (v.invalid != static_cast<bool>(src & kInvalid)) {
       set_condition(sensor, kInvalid, v.invalid, FaultKind::kInvalid, s.t,
-                    name + (v.invalid ? ": repeated non-finite or absurd values"
-                                      : ": values plausible again"),
+                    std::string(name) + (v.invalid ? ": repeated non-finite or absurd values"
+                                                   : ": values plausible again"),
                     out);
     }
   }
@@ -279,7 +280,7 @@ void Isolator::update_jump_checks(const Sample& s, JumpVerdict verdict[2]) {
 void Isolator::apply_jump_verdict(int c, const JumpVerdict& v, const Vec2& e, double t,
                                   std::vector<Detection>* out) {
   const Sensor sensor = channel_sensor(c);
-  const std::string name = c == kV ? "accelerometer channel v: " : "gyro channel r: ";
+  const char* name = c == kV ? "accelerometer channel v: " : "gyro channel r: ";
   // The detection just emitted (if any) gets the check's onset, statistic and confidence.
   const auto patch = [&](std::size_t before, double onset, double stat, double thr) {
     if (out->size() == before || !out->back().active) return;
@@ -314,7 +315,8 @@ void Isolator::apply_jump_verdict(int c, const JumpVerdict& v, const Vec2& e, do
   // A jump the check no longer holds (withdrawn as the first samples of a noise rise) is
   // no source of this condition either.
   if ((sens_[c].cond.sources & kJump) && !jump_[c].jump_raised()) {
-    set_condition(sensor, kJump, false, FaultKind::kBias, t, name + "jump withdrawn", out);
+    set_condition(sensor, kJump, false, FaultKind::kBias, t, std::string(name) + "jump withdrawn",
+                  out);
   }
 }
 
@@ -336,13 +338,14 @@ void Isolator::jump_was_noise(int c, const std::string& message, double t,
   }
 }
 
-void Isolator::hand_jump_to_observers(int c, const std::string& name, double t,
+void Isolator::hand_jump_to_observers(int c, const char* name, double t,
                                       std::vector<Detection>* out) {
   // Once the observers are live they hold a jump like any residual fault (their cross
   // residual sees whether the offset is still there, or has gone without a jump back).
   const Sensor sensor = channel_sensor(c);
   const bool held = sens_[c].cond.sources & kResidual;  // the observers hold it already
-  set_condition(sensor, kResidual, true, FaultKind::kBias, t, name + "held by the observers", out);
+  set_condition(sensor, kResidual, true, FaultKind::kBias, t,
+                std::string(name) + "held by the observers", out);
   set_condition(sensor, kJump, false, FaultKind::kBias, t, "", out);
   if (!held) {
     sens_[c].raised_at = t;

@@ -300,8 +300,7 @@ class Isolator {
   /// The jump raised just before a noise rise was its first samples: one noise condition.
   void jump_was_noise(int c, const std::string& message, double t, std::vector<Detection>* out);
   /// The observers, live, take over a jump's condition.
-  void hand_jump_to_observers(int c, const std::string& name, double t,
-                              std::vector<Detection>* out);
+  void hand_jump_to_observers(int c, const char* name, double t, std::vector<Detection>* out);
   /// The observers are designed, settled and have learned their statistics.
   bool model_live() const;
   /// The observers' residuals, one sample: a short sequence of the steps below.
