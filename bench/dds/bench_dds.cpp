@@ -380,165 +380,228 @@ std::size_t count_of(const std::string& text, const std::string& what) {
   return n;
 }
 
+/// Where and how the driver starts its responders: the options, this executable (the echo),
+/// the log directory and a tag that keeps this run's partitions apart from any other's.
+struct Driver {
+  const Options& o;
+  std::string self;
+  std::string dir;
+  std::string tag;
+
+  /// A responder's command line: head, then the domain, partition and participant profile.
+  std::vector<std::string> command(std::vector<std::string> head,
+                                   const std::string& partition) const {
+    for (const std::string& a :
+         {std::string("--domain"), std::to_string(o.domain), std::string("--partition"), partition,
+          std::string("--participant-profile"), o.participant}) {
+      head.push_back(a);
+    }
+    return head;
+  }
+};
+
+/// The two responders of one part of the benchmark, `name`: the sidecar (`usv-fdi run` with
+/// write_service_config) and the echo, logging to <dir>/<name>_sidecar.log and _echo.log.
+struct Responders {
+  Responders(const Driver& d, const std::string& name, const std::string& svc_partition,
+             const std::string& echo_partition, bool invalid_raises_at_once)
+      : sidecar(d.command({USV_FDI_EXE, "run", "--config",
+                           write_service_config(d.dir, name, invalid_raises_at_once)},
+                          svc_partition),
+                d.dir + "/" + name + "_sidecar.log"),
+        echo(d.command({d.self, "echo"}, echo_partition), d.dir + "/" + name + "_echo.log") {}
+
+  /// Whether both said they are ready within 15 s (a message on stderr if not).
+  static bool started(const Driver& d, const std::string& name) {
+    if (!wait_for_text(d.dir + "/" + name + "_sidecar.log", "waiting for INS", 15) ||
+        !wait_for_text(d.dir + "/" + name + "_echo.log", "echo ready", 15)) {
+      std::fprintf(stderr, "responders did not start; see %s\n", d.dir.c_str());
+      return false;
+    }
+    return true;
+  }
+
+  Child sidecar;
+  Child echo;
+};
+
+/// One path of the latency run: the endpoint to its responder, its data time, the measured
+/// latencies [us] and the faults whose events did not come.
+struct LatencyPath {
+  LatencyPath(const Options& o, const std::string& partition, bool is_sidecar)
+      : ep(o, partition), sidecar(is_sidecar) {}
+  Endpoint ep;
+  bool sidecar;  ///< the sidecar clears the fault itself; the echo's events are drained
+  double t = 0.0;
+  std::vector<double> latency_us;
+  int lost = 0;
+};
+
+/// `block` faults: an absurd INS value, the raised event timed (kept when count), then 0.12 s
+/// of plausible data and, from the sidecar, its cleared event.
+void run_fault_block(LatencyPath* path, Voyage* voyage, int block, bool count) {
+  Endpoint& ep = path->ep;
+  for (int k = 0; k < block; ++k) {
+    usvfdi::SimRow row = voyage->next();
+    path->t += 0.02;
+    const auto t0 = ep.write(path->t, kAbsurd, row.r, row.delta);
+    Clock::time_point t1;
+    if (ep.wait_event(1, path->t, 2.0, &t1)) {
+      if (count) {
+        path->latency_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+      }
+    } else {
+      ++path->lost;
+    }
+    for (int j = 0; j < 6; ++j) {  // 0.12 s of plausible data clears the fault
+      row = voyage->next();
+      path->t += 0.02;
+      ep.write(path->t, row.v, row.r, row.delta);
+    }
+    if (path->sidecar) {
+      Clock::time_point ignored;
+      if (!ep.wait_event(3, -1, 2.0, &ignored)) ++path->lost;
+    } else {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      ep.drain();
+    }
+  }
+}
+
+void print_latency(const LatencyPath& svc_path, const LatencyPath& echo_path, int block,
+                   double took) {
+  const std::vector<double>& svc = svc_path.latency_us;
+  const std::vector<double>& echo = echo_path.latency_us;
+  std::printf("\n1. End-to-end latency, INS sample write -> FaultEvent take at the subscriber\n");
+  std::printf(
+      "   (%zu faults per path in interleaved blocks of %d, %.1f s; not received: "
+      "sidecar %d, echo %d)\n",
+      svc.size(), block, took, svc_path.lost, echo_path.lost);
+  std::printf("   %-34s %9s %9s %9s %9s\n", "path [us]", "p50", "p90", "p99", "max");
+  std::printf("   %-34s %9.1f %9.1f %9.1f %9.1f\n", "usv-fdi run (sidecar)", pct(svc, 50),
+              pct(svc, 90), pct(svc, 99), pct(svc, 100));
+  std::printf("   %-34s %9.1f %9.1f %9.1f %9.1f\n", "plain Fast DDS echo (listener)", pct(echo, 50),
+              pct(echo, 90), pct(echo, 99), pct(echo, 100));
+  std::printf("   %-34s %9.1f %9.1f %9.1f\n", "added by the sidecar", pct(svc, 50) - pct(echo, 50),
+              pct(svc, 90) - pct(echo, 90), pct(svc, 99) - pct(echo, 99));
+  std::printf("   ratio sidecar/echo: p50 %.2f, p99 %.2f; target: added p99 <= 200 us: %s\n",
+              pct(svc, 50) / pct(echo, 50), pct(svc, 99) / pct(echo, 99),
+              pct(svc, 99) - pct(echo, 99) <= 200.0 ? "met" : "NOT met");
+  std::fflush(stdout);
+}
+
+/// Part 1: faults in interleaved blocks to the sidecar and the echo, each on its partition.
+int run_latency(const Driver& d) {
+  const Options& o = d.o;
+  const std::string p_svc = "bench_svc_" + d.tag, p_echo = "bench_echo_" + d.tag;
+  Responders responders(d, "latency", p_svc, p_echo, true);
+  if (!Responders::started(d, "latency")) return 1;
+  LatencyPath to_svc(o, p_svc, true), to_echo(o, p_echo, false);
+  if (!to_svc.ep.matched(15) || !to_echo.ep.matched(15)) {
+    std::fprintf(stderr, "no match with the responders; see %s\n", d.dir.c_str());
+    return 1;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  Voyage voyage(50.0);
+  run_fault_block(&to_svc, &voyage, o.block, false);  // warm-up
+  run_fault_block(&to_echo, &voyage, o.block, false);
+  const auto t_start = Clock::now();
+  while (static_cast<int>(to_svc.latency_us.size()) < o.faults ||
+         static_cast<int>(to_echo.latency_us.size()) < o.faults) {
+    run_fault_block(&to_svc, &voyage, o.block, true);
+    run_fault_block(&to_echo, &voyage, o.block, true);
+    if (to_svc.lost + to_echo.lost > o.faults / 10) {
+      std::fprintf(stderr, "too many lost faults (sidecar %d, echo %d); see %s\n", to_svc.lost,
+                   to_echo.lost, d.dir.c_str());
+      return 1;
+    }
+  }
+  const double took = std::chrono::duration<double>(Clock::now() - t_start).count();
+  print_latency(to_svc, to_echo, o.block, took);
+  return 0;
+}
+
+/// The usage of both responders when the measurement began, its start, and the samples
+/// written in all.
+struct Feed {
+  ProcUsage svc0{}, echo0{};
+  Clock::time_point t_meas;
+  std::uint64_t written = 0;
+};
+
+/// Writes the voyage in real time at o.rate for the warm-up and then o.cpu_seconds, taking
+/// the responders' usage when the warm-up ends.
+Feed feed_in_real_time(const Options& o, Endpoint* ep, const Responders& responders,
+                       double warmup) {
+  Voyage voyage(o.rate);
+  const auto t0 = Clock::now();
+  Feed f;
+  bool started = false;
+  std::uint64_t& k = f.written;
+  for (;;) {
+    const double t = static_cast<double>(k) / o.rate;
+    std::this_thread::sleep_until(
+        t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t)));
+    if (!started && t >= warmup) {
+      f.svc0 = usage(responders.sidecar.pid());
+      f.echo0 = usage(responders.echo.pid());
+      f.t_meas = Clock::now();
+      started = true;
+    }
+    if (t >= warmup + o.cpu_seconds) break;
+    const usvfdi::SimRow r = voyage.next();
+    ep->write(r.t, r.v, r.r, r.delta);
+    ++k;
+  }
+  return f;
+}
+
+/// Part 2: one stream in real time to a fresh sidecar and a fresh echo on one partition.
+int run_cpu(const Driver& d) {
+  const Options& o = d.o;
+  const std::string part = "bench_cpu_" + d.tag;
+  Responders responders(d, "cpu", part, part, false);
+  if (!Responders::started(d, "cpu")) return 1;
+  Endpoint ep(o, part);
+  if (!ep.matched(15)) {
+    std::fprintf(stderr, "no match with the responders; see %s\n", d.dir.c_str());
+    return 1;
+  }
+  const double warmup = 5.0;
+  const Feed f = feed_in_real_time(o, &ep, responders, warmup);
+  const double wall = std::chrono::duration<double>(Clock::now() - f.t_meas).count();
+  const ProcUsage s0 = f.svc0, e0 = f.echo0;
+  const ProcUsage s1 = usage(responders.sidecar.pid()), e1 = usage(responders.echo.pid());
+  const std::string svc_log = slurp(d.dir + "/cpu_sidecar.log");
+  std::printf(
+      "\n2. Resources at %.0f Hz INS + rudder input (Otter, autopilot, realistic noise), "
+      "%.0f s after %.0f s warm-up\n",
+      o.rate, wall, warmup);
+  std::printf("   %-34s %9s %9s %9s\n", "process", "CPU [%]", "RSS [MB]", "HWM [MB]");
+  std::printf("   %-34s %9.2f %9.1f %9.1f\n", "usv-fdi run (sidecar)",
+              100.0 * (s1.cpu_s - s0.cpu_s) / wall, s1.rss_mb, s1.hwm_mb);
+  std::printf("   %-34s %9.2f %9.1f %9.1f\n", "plain Fast DDS echo (same stream)",
+              100.0 * (e1.cpu_s - e0.cpu_s) / wall, e1.rss_mb, e1.hwm_mb);
+  std::printf(
+      "   sidecar/echo: CPU %.2f, RSS %.2f; targets < 2 %% of a core: %s, < 40 MB RSS: "
+      "%s\n",
+      (s1.cpu_s - s0.cpu_s) / std::max(1e-9, e1.cpu_s - e0.cpu_s), s1.rss_mb / e1.rss_mb,
+      100.0 * (s1.cpu_s - s0.cpu_s) / wall < 2.0 ? "met" : "NOT met",
+      s1.hwm_mb < 40.0 ? "met" : "NOT met");
+  std::printf("   (%llu samples written; the sidecar raised %zu fault events)\n",
+              static_cast<unsigned long long>(f.written), count_of(svc_log, "fault event MMSI"));
+  return 0;
+}
+
 int run_driver(const Options& o, const char* self) {
   char tmpl[] = "/tmp/usv_fdi_bench_dds_XXXXXX";
   if (mkdtemp(tmpl) == nullptr) throw std::runtime_error("mkdtemp failed");
-  const std::string dir = tmpl;
-  const std::string domain = std::to_string(o.domain);
-  const std::string tag = std::to_string(::getpid());
-  auto common = [&](const std::string& partition) {
-    return std::vector<std::string>{
-        "--domain", domain, "--partition", partition, "--participant-profile", o.participant};
-  };
+  const Driver d{o, self, tmpl, std::to_string(::getpid())};
   std::printf("usv-fdi DDS benchmark: domain %s, participant profile %s, logs in %s\n",
-              domain.c_str(), o.participant.c_str(), dir.c_str());
+              std::to_string(o.domain).c_str(), o.participant.c_str(), d.dir.c_str());
   std::fflush(stdout);
-
-  if (o.latency) {
-    const std::string p_svc = "bench_svc_" + tag, p_echo = "bench_echo_" + tag;
-    std::vector<std::string> svc_args = {USV_FDI_EXE, "run", "--config",
-                                         write_service_config(dir, "latency", true)};
-    for (const auto& a : common(p_svc)) svc_args.push_back(a);
-    Child svc(svc_args, dir + "/latency_sidecar.log");
-    std::vector<std::string> echo_args = {self, "echo"};
-    for (const auto& a : common(p_echo)) echo_args.push_back(a);
-    Child echo(echo_args, dir + "/latency_echo.log");
-    if (!wait_for_text(dir + "/latency_sidecar.log", "waiting for INS", 15) ||
-        !wait_for_text(dir + "/latency_echo.log", "echo ready", 15)) {
-      std::fprintf(stderr, "responders did not start; see %s\n", dir.c_str());
-      return 1;
-    }
-    Endpoint to_svc(o, p_svc), to_echo(o, p_echo);
-    if (!to_svc.matched(15) || !to_echo.matched(15)) {
-      std::fprintf(stderr, "no match with the responders; see %s\n", dir.c_str());
-      return 1;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    Voyage voyage(50.0);
-    double t_svc = 0.0, t_echo = 0.0;
-    std::vector<double> lat_svc, lat_echo;
-    int lost_svc = 0, lost_echo = 0;
-    const auto run_block = [&](Endpoint& ep, double* t, std::vector<double>* out, int* lost,
-                               bool sidecar, bool count) {
-      for (int k = 0; k < o.block; ++k) {
-        usvfdi::SimRow row = voyage.next();
-        *t += 0.02;
-        const auto t0 = ep.write(*t, kAbsurd, row.r, row.delta);
-        Clock::time_point t1;
-        if (ep.wait_event(1, *t, 2.0, &t1)) {
-          if (count) out->push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-        } else {
-          ++*lost;
-        }
-        for (int j = 0; j < 6; ++j) {  // 0.12 s of plausible data clears the fault
-          row = voyage.next();
-          *t += 0.02;
-          ep.write(*t, row.v, row.r, row.delta);
-        }
-        if (sidecar) {
-          Clock::time_point ignored;
-          if (!ep.wait_event(3, -1, 2.0, &ignored)) ++*lost;
-        } else {
-          std::this_thread::sleep_for(std::chrono::microseconds(200));
-          ep.drain();
-        }
-      }
-    };
-    run_block(to_svc, &t_svc, &lat_svc, &lost_svc, true, false);  // warm-up
-    run_block(to_echo, &t_echo, &lat_echo, &lost_echo, false, false);
-    const auto t_start = Clock::now();
-    while (static_cast<int>(lat_svc.size()) < o.faults ||
-           static_cast<int>(lat_echo.size()) < o.faults) {
-      run_block(to_svc, &t_svc, &lat_svc, &lost_svc, true, true);
-      run_block(to_echo, &t_echo, &lat_echo, &lost_echo, false, true);
-      if (lost_svc + lost_echo > o.faults / 10) {
-        std::fprintf(stderr, "too many lost faults (sidecar %d, echo %d); see %s\n", lost_svc,
-                     lost_echo, dir.c_str());
-        return 1;
-      }
-    }
-    const double took = std::chrono::duration<double>(Clock::now() - t_start).count();
-    std::printf("\n1. End-to-end latency, INS sample write -> FaultEvent take at the subscriber\n");
-    std::printf(
-        "   (%zu faults per path in interleaved blocks of %d, %.1f s; not received: "
-        "sidecar %d, echo %d)\n",
-        lat_svc.size(), o.block, took, lost_svc, lost_echo);
-    std::printf("   %-34s %9s %9s %9s %9s\n", "path [us]", "p50", "p90", "p99", "max");
-    std::printf("   %-34s %9.1f %9.1f %9.1f %9.1f\n", "usv-fdi run (sidecar)", pct(lat_svc, 50),
-                pct(lat_svc, 90), pct(lat_svc, 99), pct(lat_svc, 100));
-    std::printf("   %-34s %9.1f %9.1f %9.1f %9.1f\n", "plain Fast DDS echo (listener)",
-                pct(lat_echo, 50), pct(lat_echo, 90), pct(lat_echo, 99), pct(lat_echo, 100));
-    std::printf("   %-34s %9.1f %9.1f %9.1f\n", "added by the sidecar",
-                pct(lat_svc, 50) - pct(lat_echo, 50), pct(lat_svc, 90) - pct(lat_echo, 90),
-                pct(lat_svc, 99) - pct(lat_echo, 99));
-    std::printf("   ratio sidecar/echo: p50 %.2f, p99 %.2f; target: added p99 <= 200 us: %s\n",
-                pct(lat_svc, 50) / pct(lat_echo, 50), pct(lat_svc, 99) / pct(lat_echo, 99),
-                pct(lat_svc, 99) - pct(lat_echo, 99) <= 200.0 ? "met" : "NOT met");
-    std::fflush(stdout);
-  }
-
-  if (o.cpu) {
-    const std::string part = "bench_cpu_" + tag;
-    std::vector<std::string> svc_args = {USV_FDI_EXE, "run", "--config",
-                                         write_service_config(dir, "cpu", false)};
-    for (const auto& a : common(part)) svc_args.push_back(a);
-    Child svc(svc_args, dir + "/cpu_sidecar.log");
-    std::vector<std::string> echo_args = {self, "echo"};
-    for (const auto& a : common(part)) echo_args.push_back(a);
-    Child echo(echo_args, dir + "/cpu_echo.log");
-    if (!wait_for_text(dir + "/cpu_sidecar.log", "waiting for INS", 15) ||
-        !wait_for_text(dir + "/cpu_echo.log", "echo ready", 15)) {
-      std::fprintf(stderr, "responders did not start; see %s\n", dir.c_str());
-      return 1;
-    }
-    Endpoint ep(o, part);
-    if (!ep.matched(15)) {
-      std::fprintf(stderr, "no match with the responders; see %s\n", dir.c_str());
-      return 1;
-    }
-    Voyage voyage(o.rate);
-    const double warmup = 5.0;
-    const auto t0 = Clock::now();
-    ProcUsage s0{}, e0{};
-    bool started = false;
-    Clock::time_point t_meas;
-    std::uint64_t k = 0;
-    for (;;) {
-      const double t = static_cast<double>(k) / o.rate;
-      std::this_thread::sleep_until(
-          t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t)));
-      if (!started && t >= warmup) {
-        s0 = usage(svc.pid());
-        e0 = usage(echo.pid());
-        t_meas = Clock::now();
-        started = true;
-      }
-      if (t >= warmup + o.cpu_seconds) break;
-      const usvfdi::SimRow r = voyage.next();
-      ep.write(r.t, r.v, r.r, r.delta);
-      ++k;
-    }
-    const double wall = std::chrono::duration<double>(Clock::now() - t_meas).count();
-    const ProcUsage s1 = usage(svc.pid()), e1 = usage(echo.pid());
-    const std::string svc_log = slurp(dir + "/cpu_sidecar.log");
-    std::printf(
-        "\n2. Resources at %.0f Hz INS + rudder input (Otter, autopilot, realistic noise), "
-        "%.0f s after %.0f s warm-up\n",
-        o.rate, wall, warmup);
-    std::printf("   %-34s %9s %9s %9s\n", "process", "CPU [%]", "RSS [MB]", "HWM [MB]");
-    std::printf("   %-34s %9.2f %9.1f %9.1f\n", "usv-fdi run (sidecar)",
-                100.0 * (s1.cpu_s - s0.cpu_s) / wall, s1.rss_mb, s1.hwm_mb);
-    std::printf("   %-34s %9.2f %9.1f %9.1f\n", "plain Fast DDS echo (same stream)",
-                100.0 * (e1.cpu_s - e0.cpu_s) / wall, e1.rss_mb, e1.hwm_mb);
-    std::printf(
-        "   sidecar/echo: CPU %.2f, RSS %.2f; targets < 2 %% of a core: %s, < 40 MB RSS: "
-        "%s\n",
-        (s1.cpu_s - s0.cpu_s) / std::max(1e-9, e1.cpu_s - e0.cpu_s), s1.rss_mb / e1.rss_mb,
-        100.0 * (s1.cpu_s - s0.cpu_s) / wall < 2.0 ? "met" : "NOT met",
-        s1.hwm_mb < 40.0 ? "met" : "NOT met");
-    std::printf("   (%llu samples written; the sidecar raised %zu fault events)\n",
-                static_cast<unsigned long long>(k), count_of(svc_log, "fault event MMSI"));
-  }
+  if (o.latency && run_latency(d) != 0) return 1;
+  if (o.cpu && run_cpu(d) != 0) return 1;
   return 0;
 }
 

@@ -47,6 +47,90 @@ std::string json_str(const std::string& s) {
   return o + "\"";
 }
 
+/// One method's aggregate over a table, as a JSON object.
+void write_method_summary(std::ostream& o, const MethodSummary& m) {
+  o << "{\"faults\": " << m.faults << ", \"detected\": " << m.detected
+    << ", \"isolated\": " << m.isolated << ", \"armed_at_onset\": " << m.armed_at_onset
+    << ", \"detected_when_armed\": " << m.detected_armed << ", \"recovered\": " << m.recovered
+    << ", \"false_alarms\": " << m.false_alarms
+    << ", \"healthy_hours\": " << json_num(m.healthy_hours)
+    << ", \"healthy_armed_hours\": " << json_num(m.healthy_armed_hours)
+    << ", \"false_alarms_per_hour\": " << json_num(m.fa_per_hour())
+    << ", \"false_alarms_armed\": " << m.false_alarms_armed
+    << ", \"false_alarms_per_armed_hour\": " << json_num(m.fa_per_armed_hour())
+    << ", \"delay_median\": " << json_num(m.delay_median)
+    << ", \"delay_p95\": " << json_num(m.delay_p95)
+    << ", \"recovery_median\": " << json_num(m.recovery_median)
+    << ", \"recovery_p95\": " << json_num(m.recovery_p95) << ", \"runs\": " << m.runs
+    << ", \"armed_runs\": " << m.armed_runs << ", \"arming_median\": " << json_num(m.arming_median)
+    << ", \"arming_max\": " << json_num(m.arming_max)
+    << ", \"a_error_median\": " << json_num(m.a_error_median)
+    << ", \"a_error_p95\": " << json_num(m.a_error_p95) << ", \"per_kind\": {";
+  for (std::size_t i = 0; i < standard_kinds().size(); ++i) {
+    o << (i ? ", " : "") << json_str(to_string(standard_kinds()[i])) << ": [" << m.per_kind[i][0]
+      << ", " << m.per_kind[i][1] << ", " << m.per_kind[i][2] << "]";
+  }
+  o << "}}";
+}
+
+/// One table (its name, note, size and every method's aggregate), as a JSON object.
+void write_table(std::ostream& o, const TableSummary& t) {
+  o << "{\"name\": " << json_str(t.name) << ", \"note\": " << json_str(t.note)
+    << ", \"runs\": " << t.runs << ", \"hours\": " << json_num(t.hours) << ", \"methods\": {";
+  for (int k = 0; k < kMethods; ++k) {
+    o << (k ? ", " : "") << json_str(method_name(k)) << ": ";
+    write_method_summary(o, t.m[k]);
+  }
+  o << "}}";
+}
+
+/// One method's result on the run of case c, as a JSON object.
+void write_method_result(std::ostream& o, const Case& c, const MethodResult& m) {
+  const double ref = c.A_ref.norm();
+  o << "{\"t_armed\": " << json_num(m.t_armed)
+    << ", \"converged\": " << (m.converged ? "true" : "false")
+    << ", \"a_error\": " << json_num(ref > 0 ? (m.A_final - c.A_ref).norm() / ref : kNaN)
+    << ", \"A_final\": [" << json_num(m.A_final(0, 0)) << ", " << json_num(m.A_final(0, 1)) << ", "
+    << json_num(m.A_final(1, 0)) << ", " << json_num(m.A_final(1, 1)) << "]"
+    << ", \"healthy_s\": " << json_num(m.score.healthy_time) << ", \"false_alarms\": [";
+  for (std::size_t j = 0; j < m.score.false_alarm_events.size(); ++j) {
+    const Alarm& a = m.score.false_alarm_events[j];
+    o << (j ? ", " : "") << "[" << json_num(a.t) << ", " << json_str(to_string(a.sensor)) << ", "
+      << json_str(to_string(a.kind)) << "]";
+  }
+  o << "]";
+  for (const FaultScore& f : m.score.faults) {
+    o << ", \"detected\": " << (f.detected ? "true" : "false")
+      << ", \"isolated\": " << (f.isolated ? "true" : "false")
+      << ", \"raised_sensor\": " << json_str(f.detected ? to_string(f.raised_sensor) : "")
+      << ", \"delay\": " << json_num(f.delay)
+      << ", \"recovery_delay\": " << json_num(f.recovery_delay);
+  }
+  o << "}";
+}
+
+/// One run (its case, its data span, the fault put in and every method's result), as a JSON
+/// object.
+void write_run(std::ostream& o, const Case& c, const CaseResult& r) {
+  o << "{\"table\": " << json_str(c.table) << ", \"voyage\": " << json_str(c.voyage)
+    << ", \"rate_hz\": " << json_num(c.rate_hz) << ", \"seed\": " << c.seed
+    << ", \"samples\": " << r.samples << ", \"t_first\": " << json_num(r.t_first)
+    << ", \"t_last\": " << json_num(r.t_last);
+  if (c.faulty) {
+    o << ", \"fault\": {\"sensor\": " << json_str(to_string(c.fault.sensor))
+      << ", \"kind\": " << json_str(to_string(c.fault.kind))
+      << ", \"t_start\": " << json_num(c.fault.t_start)
+      << ", \"t_end\": " << json_num(c.fault.t_end) << ", \"magnitude\": " << json_num(c.magnitude)
+      << "}";
+  }
+  o << ", \"methods\": {";
+  for (int k = 0; k < kMethods; ++k) {
+    o << (k ? ", " : "") << json_str(method_name(k)) << ": ";
+    write_method_result(o, c, r.m[k]);
+  }
+  o << "}}";
+}
+
 }  // namespace
 
 std::string to_overview(const std::vector<TableSummary>& tables) {
@@ -128,79 +212,15 @@ std::string to_json(const std::vector<Case>& cases, const std::vector<CaseResult
   std::ostringstream o;
   o << "{\n  \"header\": " << json_str(header) << ",\n  \"tables\": [\n";
   for (std::size_t ti = 0; ti < tables.size(); ++ti) {
-    const TableSummary& t = tables[ti];
-    o << "    {\"name\": " << json_str(t.name) << ", \"note\": " << json_str(t.note)
-      << ", \"runs\": " << t.runs << ", \"hours\": " << json_num(t.hours) << ", \"methods\": {";
-    for (int k = 0; k < kMethods; ++k) {
-      const MethodSummary& m = t.m[k];
-      o << (k ? ", " : "") << json_str(method_name(k)) << ": {\"faults\": " << m.faults
-        << ", \"detected\": " << m.detected << ", \"isolated\": " << m.isolated
-        << ", \"armed_at_onset\": " << m.armed_at_onset
-        << ", \"detected_when_armed\": " << m.detected_armed << ", \"recovered\": " << m.recovered
-        << ", \"false_alarms\": " << m.false_alarms
-        << ", \"healthy_hours\": " << json_num(m.healthy_hours)
-        << ", \"healthy_armed_hours\": " << json_num(m.healthy_armed_hours)
-        << ", \"false_alarms_per_hour\": " << json_num(m.fa_per_hour())
-        << ", \"false_alarms_armed\": " << m.false_alarms_armed
-        << ", \"false_alarms_per_armed_hour\": " << json_num(m.fa_per_armed_hour())
-        << ", \"delay_median\": " << json_num(m.delay_median)
-        << ", \"delay_p95\": " << json_num(m.delay_p95)
-        << ", \"recovery_median\": " << json_num(m.recovery_median)
-        << ", \"recovery_p95\": " << json_num(m.recovery_p95) << ", \"runs\": " << m.runs
-        << ", \"armed_runs\": " << m.armed_runs
-        << ", \"arming_median\": " << json_num(m.arming_median)
-        << ", \"arming_max\": " << json_num(m.arming_max)
-        << ", \"a_error_median\": " << json_num(m.a_error_median)
-        << ", \"a_error_p95\": " << json_num(m.a_error_p95) << ", \"per_kind\": {";
-      for (std::size_t i = 0; i < standard_kinds().size(); ++i) {
-        o << (i ? ", " : "") << json_str(to_string(standard_kinds()[i])) << ": ["
-          << m.per_kind[i][0] << ", " << m.per_kind[i][1] << ", " << m.per_kind[i][2] << "]";
-      }
-      o << "}}";
-    }
-    o << "}}" << (ti + 1 < tables.size() ? "," : "") << "\n";
+    o << "    ";
+    write_table(o, tables[ti]);
+    o << (ti + 1 < tables.size() ? "," : "") << "\n";
   }
   o << "  ],\n  \"runs\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
-    const CaseResult& r = results[i];
-    const Case& c = cases[r.index];
-    o << "    {\"table\": " << json_str(c.table) << ", \"voyage\": " << json_str(c.voyage)
-      << ", \"rate_hz\": " << json_num(c.rate_hz) << ", \"seed\": " << c.seed
-      << ", \"samples\": " << r.samples << ", \"t_first\": " << json_num(r.t_first)
-      << ", \"t_last\": " << json_num(r.t_last);
-    if (c.faulty) {
-      o << ", \"fault\": {\"sensor\": " << json_str(to_string(c.fault.sensor))
-        << ", \"kind\": " << json_str(to_string(c.fault.kind))
-        << ", \"t_start\": " << json_num(c.fault.t_start)
-        << ", \"t_end\": " << json_num(c.fault.t_end)
-        << ", \"magnitude\": " << json_num(c.magnitude) << "}";
-    }
-    o << ", \"methods\": {";
-    for (int k = 0; k < kMethods; ++k) {
-      const MethodResult& m = r.m[k];
-      const double ref = c.A_ref.norm();
-      o << (k ? ", " : "") << json_str(method_name(k)) << ": {\"t_armed\": " << json_num(m.t_armed)
-        << ", \"converged\": " << (m.converged ? "true" : "false")
-        << ", \"a_error\": " << json_num(ref > 0 ? (m.A_final - c.A_ref).norm() / ref : kNaN)
-        << ", \"A_final\": [" << json_num(m.A_final(0, 0)) << ", " << json_num(m.A_final(0, 1))
-        << ", " << json_num(m.A_final(1, 0)) << ", " << json_num(m.A_final(1, 1)) << "]"
-        << ", \"healthy_s\": " << json_num(m.score.healthy_time) << ", \"false_alarms\": [";
-      for (std::size_t j = 0; j < m.score.false_alarm_events.size(); ++j) {
-        const Alarm& a = m.score.false_alarm_events[j];
-        o << (j ? ", " : "") << "[" << json_num(a.t) << ", " << json_str(to_string(a.sensor))
-          << ", " << json_str(to_string(a.kind)) << "]";
-      }
-      o << "]";
-      for (const FaultScore& f : m.score.faults) {
-        o << ", \"detected\": " << (f.detected ? "true" : "false")
-          << ", \"isolated\": " << (f.isolated ? "true" : "false")
-          << ", \"raised_sensor\": " << json_str(f.detected ? to_string(f.raised_sensor) : "")
-          << ", \"delay\": " << json_num(f.delay)
-          << ", \"recovery_delay\": " << json_num(f.recovery_delay);
-      }
-      o << "}";
-    }
-    o << "}}" << (i + 1 < results.size() ? "," : "") << "\n";
+    o << "    ";
+    write_run(o, cases[results[i].index], results[i]);
+    o << (i + 1 < results.size() ? "," : "") << "\n";
   }
   o << "  ]\n}\n";
   return o.str();

@@ -272,9 +272,9 @@ Stream voyage_stream(const std::shared_ptr<const sim::Hull>& hull, const std::st
   return st;
 }
 
-}  // namespace
-
-std::vector<Case> make_cases(const BenchOptions& opt) {
+/// The run list's dimensions in the quick (CI) and the full mode; --seeds overrides both
+/// seed counts.
+Plan plan_of(const BenchOptions& opt) {
   Plan p;
   if (opt.quick) {
     p.rates = {10.0, 50.0};
@@ -296,170 +296,224 @@ std::vector<Case> make_cases(const BenchOptions& opt) {
     p.healthy_len = 4 * 3600.0;
   }
   if (opt.seeds > 0) p.seeds = p.healthy_seeds = opt.seeds;
+  return p;
+}
 
-  std::vector<Case> cases;
-  auto keep = [&](const std::string& table) {
-    return opt.only.empty() || table.find(opt.only) != std::string::npos;
+/// --only: whether a table is run.
+bool wanted(const BenchOptions& opt, const std::string& table) {
+  return opt.only.empty() || table.find(opt.only) != std::string::npos;
+}
+
+/// What the runs of a zoo table share: the model, the INS noise, the voyages.
+std::string zoo_note(const Subject& sub, const Plan& p) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "%s model at %.4g m/s (B and the oracle's A from its linearisation); INS "
+                "white noise sigma_v = %.2g m/s, sigma_r = %.2g rad/s; voyages:",
+                sub.hull->nonlinear() ? "nonlinear 3-DOF" : "linear", sub.lin.u0, kInsSigmaV,
+                kInsSigmaR);
+  std::string note = buf;
+  for (const std::string& voyage : p.voyages) note += " " + voyage;
+  return note;
+}
+
+/// The simulator's form of a fault of a case.
+FaultInjection to_injection(const InjectedFault& f, double magnitude) {
+  FaultInjection fi;
+  fi.sensor = f.sensor;
+  fi.kind = f.kind;
+  fi.t_start = f.t_start;
+  fi.t_end = f.t_end;
+  fi.magnitude = magnitude;
+  return fi;
+}
+
+/// One zoo table (a subject at a rate): on every voyage its healthy runs, then for every
+/// seed each standard fault on each channel. Every case takes the next seed of *serial.
+void add_zoo_table(const Subject& sub, double rate, const Plan& p, const std::string& table,
+                   std::uint64_t* serial, std::vector<Case>* cases) {
+  const std::string note = zoo_note(sub, p);
+  // A case of this table on that voyage, with the next seed.
+  const auto voyage_case = [&](const std::string& voyage) {
+    Case c;
+    c.table = table;
+    c.note = note;
+    c.subject = sub.name;
+    c.voyage = voyage;
+    c.rate_hz = rate;
+    c.seed = mix_seed(++*serial);
+    c.B = sub.lin.B;
+    c.A_ref = sub.lin.A;
+    return c;
   };
+  for (const std::string& voyage : p.voyages) {
+    for (int h = 0; h < p.healthy_seeds; ++h) {
+      Case c = voyage_case(voyage);
+      c.duration = p.healthy_len;
+      c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration] {
+        return voyage_stream(hull, voyage, rate, seed, d, {});
+      };
+      cases->push_back(std::move(c));
+    }
+    for (int s = 0; s < p.seeds; ++s) {
+      // The onset moves with the seed, so that the faults meet different manoeuvres,
+      // and lies 5 s before a leg begins: a scale error, invisible while the vessel
+      // holds its course, meets a manoeuvre within the fault.
+      const double onset = onset_before_leg(*sub.hull, voyage, p.onset + 61.0 * s);
+      for (Sensor sensor : {Sensor::kAccelerometer, Sensor::kGyro}) {
+        const double sigma = sensor == Sensor::kAccelerometer ? kInsSigmaV : kInsSigmaR;
+        for (const FaultSpec& spec : standard_faults(sigma)) {
+          Case c = voyage_case(voyage);
+          c.faulty = true;
+          c.fault = InjectedFault{sensor, spec.kind, onset, onset + p.fault_len};
+          c.magnitude = spec.magnitude;
+          c.duration = onset + p.fault_len + p.tail;
+          const FaultInjection fi = to_injection(c.fault, spec.magnitude);
+          c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration, fi] {
+            return voyage_stream(hull, voyage, rate, seed, d, {fi});
+          };
+          cases->push_back(std::move(c));
+        }
+      }
+    }
+  }
+}
+
+using Recorded = std::shared_ptr<const std::vector<RecordedRun>>;
+
+/// The README's MMG linearisation (Yasukawa & Yoshimura 2015 at model scale) and B.
+/// Each recorded test alone, healthy.
+void add_hsva_single_runs(const Recorded& runs, const HsvaModel& mmg, const std::string& table,
+                          std::vector<Case>* cases) {
+  for (std::size_t i = 0; i < runs->size(); ++i) {
+    Case c;
+    c.table = table;
+    c.note = "each recorded test alone; healthy";
+    c.subject = "kvlcc2-hsva";
+    c.voyage = (*runs)[i].name;
+    c.rate_hz = 20.0;
+    c.duration = (*runs)[i].samples.back().t - (*runs)[i].samples.front().t;
+    c.B = mmg.B;
+    c.A_ref = mmg.A_ref;
+    c.make = [runs, i] { return Stream{(*runs)[i].samples, {}}; };
+    cases->push_back(std::move(c));
+  }
+}
+
+/// Fault onsets 30 s into every run of at least 150 s (so that a 60 s fault stays in one
+/// run); the quick mode takes the one nearest to 1300 s.
+std::vector<double> hsva_fault_onsets(const std::vector<RecordedRun>& runs,
+                                      const std::vector<double>& starts, bool quick) {
+  std::vector<double> onsets;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto& x = runs[i].samples;
+    if (x.back().t - x.front().t >= 150.0) onsets.push_back(starts[i] + 30.0);
+  }
+  if (quick && !onsets.empty()) {
+    const double best = *std::min_element(onsets.begin(), onsets.end(), [](double a, double b) {
+      return std::abs(a - 1300.0) < std::abs(b - 1300.0);
+    });
+    onsets = {best};
+  }
+  return onsets;
+}
+
+/// The healthy case of the concatenated tests; the faulty ones are copies of it.
+Case hsva_concatenated_case(const std::string& table, const Vec2& noise, const Vec2& sigma,
+                            double span, const HsvaModel& mmg) {
+  Case base;
+  base.table = table;
+  char note[256];
+  std::snprintf(note, sizeof note,
+                "healthy noise of the recordings sigma_v = %.2g m/s, sigma_r = %.2g rad/s; "
+                "faults sized with sigma_v = %.2g m/s, sigma_r = %.2g rad/s (at least the "
+                "engine's scale floors)",
+                noise(0), noise(1), sigma(0), sigma(1));
+  base.note = note;
+  base.subject = "kvlcc2-hsva";
+  base.voyage = "13 runs, 3 s apart";
+  base.rate_hz = 20.0;
+  base.duration = span;
+  base.B = mmg.B;
+  base.A_ref = mmg.A_ref;
+  return base;
+}
+
+/// The recorded tests one after another, healthy, then with each standard fault on each
+/// channel at every onset (sized with the recorded noise, at least the engine's floors).
+/// Every faulty case takes the next seed of *serial.
+void add_hsva_concatenated(const Recorded& runs, const HsvaModel& mmg, const std::string& table,
+                           bool quick, std::uint64_t* serial, std::vector<Case>* cases) {
+  std::vector<double> starts;
+  auto all = std::make_shared<const std::vector<Sample>>(concatenate(*runs, 3.0, &starts));
+  const Vec2 noise = recorded_noise(*runs);
+  const Vec2 sigma = noise.cwiseMax(fault_sigma_floor());
+  const double span = all->back().t - all->front().t;
+  const Case base = hsva_concatenated_case(table, noise, sigma, span, mmg);
+  {
+    Case c = base;
+    c.make = [all] { return Stream{*all, {}}; };
+    cases->push_back(std::move(c));
+  }
+  for (double onset : hsva_fault_onsets(*runs, starts, quick)) {
+    for (Sensor sensor : {Sensor::kAccelerometer, Sensor::kGyro}) {
+      const double sg = sensor == Sensor::kAccelerometer ? sigma(0) : sigma(1);
+      for (const FaultSpec& spec : standard_faults(sg)) {
+        Case c = base;
+        c.seed = mix_seed(++*serial);
+        c.faulty = true;
+        c.fault = InjectedFault{sensor, spec.kind, onset, onset + 60.0};
+        c.magnitude = spec.magnitude;
+        c.voyage = base.voyage + ", fault at " + std::to_string(static_cast<int>(onset)) + " s";
+        c.make = [all, f = c.fault, m = spec.magnitude, seed = c.seed] {
+          Stream st{*all, {f}};
+          apply_fault(&st.samples, f, m, seed);
+          return st;
+        };
+        cases->push_back(std::move(c));
+      }
+    }
+  }
+}
+
+/// The HSVA KVLCC2 tables: the single runs and the concatenated runs with faults.
+void add_hsva_tables(const BenchOptions& opt, std::uint64_t* serial, std::vector<Case>* cases) {
+  const Recorded runs =
+      std::make_shared<const std::vector<RecordedRun>>(load_hsva(opt.realdata_dir));
+  // B as a user gives it (the directory's kvlcc2_model.yaml through the engine's loader), A
+  // for the oracle from its README.
+  const HsvaModel mmg = load_hsva_model(opt.realdata_dir);
+  const std::string single = "kvlcc2-hsva single runs @ 20 Hz";
+  if (wanted(opt, single)) add_hsva_single_runs(runs, mmg, single, cases);
+  const std::string concat = "kvlcc2-hsva concatenated @ 20 Hz";
+  if (wanted(opt, concat)) add_hsva_concatenated(runs, mmg, concat, opt.quick, serial, cases);
+}
+
+/// B only, as a user without a speed log gives it: the samples' u is dropped.
+void drop_speed(std::vector<Case>* cases) {
+  for (Case& c : *cases) {
+    c.make = [make = std::move(c.make)] {
+      Stream st = make();
+      for (Sample& x : st.samples) x.u = kNaN;
+      return st;
+    };
+  }
+}
+
+}  // namespace
+
+std::vector<Case> make_cases(const BenchOptions& opt) {
+  const Plan p = plan_of(opt);
+  std::vector<Case> cases;
   std::uint64_t serial = 0;
   for (const Subject& sub : zoo_subjects()) {
     for (double rate : p.rates) {
       const std::string table = sub.name + " @ " + rate_name(rate);
-      if (!keep(table)) continue;
-      char buf[320];
-      std::snprintf(buf, sizeof buf,
-                    "%s model at %.4g m/s (B and the oracle's A from its linearisation); INS "
-                    "white noise sigma_v = %.2g m/s, sigma_r = %.2g rad/s; voyages:",
-                    sub.hull->nonlinear() ? "nonlinear 3-DOF" : "linear", sub.lin.u0, kInsSigmaV,
-                    kInsSigmaR);
-      std::string note = buf;
-      for (const std::string& voyage : p.voyages) note += " " + voyage;
-      // A case of this table on that voyage, with the next seed.
-      const auto voyage_case = [&](const std::string& voyage) {
-        Case c;
-        c.table = table;
-        c.note = note;
-        c.subject = sub.name;
-        c.voyage = voyage;
-        c.rate_hz = rate;
-        c.seed = mix_seed(++serial);
-        c.B = sub.lin.B;
-        c.A_ref = sub.lin.A;
-        return c;
-      };
-      for (const std::string& voyage : p.voyages) {
-        for (int h = 0; h < p.healthy_seeds; ++h) {
-          Case c = voyage_case(voyage);
-          c.duration = p.healthy_len;
-          c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration] {
-            return voyage_stream(hull, voyage, rate, seed, d, {});
-          };
-          cases.push_back(std::move(c));
-        }
-        for (int s = 0; s < p.seeds; ++s) {
-          // The onset moves with the seed, so that the faults meet different manoeuvres,
-          // and lies 5 s before a leg begins: a scale error, invisible while the vessel
-          // holds its course, meets a manoeuvre within the fault.
-          const double onset = onset_before_leg(*sub.hull, voyage, p.onset + 61.0 * s);
-          for (Sensor sensor : {Sensor::kAccelerometer, Sensor::kGyro}) {
-            const double sigma = sensor == Sensor::kAccelerometer ? kInsSigmaV : kInsSigmaR;
-            for (const FaultSpec& spec : standard_faults(sigma)) {
-              Case c = voyage_case(voyage);
-              c.faulty = true;
-              c.fault = InjectedFault{sensor, spec.kind, onset, onset + p.fault_len};
-              c.magnitude = spec.magnitude;
-              c.duration = onset + p.fault_len + p.tail;
-              FaultInjection fi;
-              fi.sensor = sensor;
-              fi.kind = spec.kind;
-              fi.t_start = c.fault.t_start;
-              fi.t_end = c.fault.t_end;
-              fi.magnitude = spec.magnitude;
-              c.make = [hull = sub.hull, voyage, rate, seed = c.seed, d = c.duration, fi] {
-                return voyage_stream(hull, voyage, rate, seed, d, {fi});
-              };
-              cases.push_back(std::move(c));
-            }
-          }
-        }
-      }
+      if (wanted(opt, table)) add_zoo_table(sub, rate, p, table, &serial, &cases);
     }
   }
-
-  if (!opt.realdata_dir.empty()) {
-    auto runs = std::make_shared<const std::vector<RecordedRun>>(load_hsva(opt.realdata_dir));
-    // B as a user gives it (the directory's kvlcc2_model.yaml through the engine's loader),
-    // A for the oracle from the README (load_hsva_model).
-    const HsvaModel model = load_hsva_model(opt.realdata_dir);
-    const Mat2 A_mmg = model.A_ref;
-    const Vec2 B_mmg = model.B;
-    const std::string single = "kvlcc2-hsva single runs @ 20 Hz";
-    if (keep(single)) {
-      for (std::size_t i = 0; i < runs->size(); ++i) {
-        Case c;
-        c.table = single;
-        c.note = "each recorded test alone; healthy";
-        c.subject = "kvlcc2-hsva";
-        c.voyage = (*runs)[i].name;
-        c.rate_hz = 20.0;
-        c.duration = (*runs)[i].samples.back().t - (*runs)[i].samples.front().t;
-        c.B = B_mmg;
-        c.A_ref = A_mmg;
-        c.make = [runs, i] { return Stream{(*runs)[i].samples, {}}; };
-        cases.push_back(std::move(c));
-      }
-    }
-    const std::string concat = "kvlcc2-hsva concatenated @ 20 Hz";
-    if (keep(concat)) {
-      std::vector<double> starts;
-      auto all = std::make_shared<const std::vector<Sample>>(concatenate(*runs, 3.0, &starts));
-      const Vec2 noise = recorded_noise(*runs);
-      const Vec2 sigma = noise.cwiseMax(fault_sigma_floor());
-      const double span = all->back().t - all->front().t;
-      Case base;
-      base.table = concat;
-      char note[256];
-      std::snprintf(note, sizeof note,
-                    "healthy noise of the recordings sigma_v = %.2g m/s, sigma_r = %.2g rad/s; "
-                    "faults sized with sigma_v = %.2g m/s, sigma_r = %.2g rad/s (at least the "
-                    "engine's scale floors)",
-                    noise(0), noise(1), sigma(0), sigma(1));
-      base.note = note;
-      base.subject = "kvlcc2-hsva";
-      base.voyage = "13 runs, 3 s apart";
-      base.rate_hz = 20.0;
-      base.duration = span;
-      base.B = B_mmg;
-      base.A_ref = A_mmg;
-      {
-        Case c = base;
-        c.make = [all] { return Stream{*all, {}}; };
-        cases.push_back(std::move(c));
-      }
-      // Fault onsets 30 s into every run of at least 150 s (so that a 60 s fault stays in
-      // one run); the quick mode takes the one nearest to 1300 s.
-      std::vector<double> onsets;
-      for (std::size_t i = 0; i < runs->size(); ++i) {
-        const auto& x = (*runs)[i].samples;
-        if (x.back().t - x.front().t >= 150.0) onsets.push_back(starts[i] + 30.0);
-      }
-      if (opt.quick && !onsets.empty()) {
-        const double best = *std::min_element(onsets.begin(), onsets.end(), [](double a, double b) {
-          return std::abs(a - 1300.0) < std::abs(b - 1300.0);
-        });
-        onsets = {best};
-      }
-      for (double onset : onsets) {
-        for (Sensor sensor : {Sensor::kAccelerometer, Sensor::kGyro}) {
-          const double sg = sensor == Sensor::kAccelerometer ? sigma(0) : sigma(1);
-          for (const FaultSpec& spec : standard_faults(sg)) {
-            Case c = base;
-            c.seed = mix_seed(++serial);
-            c.faulty = true;
-            c.fault = InjectedFault{sensor, spec.kind, onset, onset + 60.0};
-            c.magnitude = spec.magnitude;
-            c.voyage = base.voyage + ", fault at " + std::to_string(static_cast<int>(onset)) + " s";
-            c.make = [all, f = c.fault, m = spec.magnitude, seed = c.seed] {
-              Stream st{*all, {f}};
-              apply_fault(&st.samples, f, m, seed);
-              return st;
-            };
-            cases.push_back(std::move(c));
-          }
-        }
-      }
-    }
-  }
-  if (!opt.speed) {
-    // B only, as a user without a speed log gives it: the samples' u is dropped.
-    for (Case& c : cases) {
-      c.make = [make = std::move(c.make)] {
-        Stream st = make();
-        for (Sample& x : st.samples) x.u = kNaN;
-        return st;
-      };
-    }
-  }
+  if (!opt.realdata_dir.empty()) add_hsva_tables(opt, &serial, &cases);
+  if (!opt.speed) drop_speed(&cases);
   return cases;
 }
 
@@ -485,85 +539,100 @@ CaseResult run_case(const Case& c, std::size_t index, const EngineConfig& engine
   return out;
 }
 
+namespace {
+
+/// The table of that name, appended (with empty per-kind counts) when it is new.
+TableSummary& table_named(std::vector<TableSummary>* tables, const std::string& name) {
+  for (TableSummary& t : *tables) {
+    if (t.name == name) return t;
+  }
+  tables->push_back(TableSummary{});
+  tables->back().name = name;
+  for (MethodSummary& m : tables->back().m) {
+    m.per_kind.assign(standard_kinds().size(), {0, 0, 0});
+  }
+  return tables->back();
+}
+
+/// The values of one method over one table whose quantiles the summary reports.
+struct Acc {
+  std::vector<double> delay, recovery, arming, a_error;
+};
+
+/// The scores of a run's faults: counts overall and per standard kind, delays, recoveries.
+void add_fault_scores(const std::vector<FaultScore>& faults, MethodSummary* m, Acc* a) {
+  for (const FaultScore& f : faults) {
+    ++m->faults;
+    const auto& kinds = standard_kinds();
+    const std::size_t kind = static_cast<std::size_t>(
+        std::find(kinds.begin(), kinds.end(), f.fault.kind) - kinds.begin());
+    if (kind < kinds.size()) ++m->per_kind[kind][0];
+    if (f.armed_at_onset) ++m->armed_at_onset;
+    if (!f.detected) continue;
+    ++m->detected;
+    if (f.armed_at_onset) ++m->detected_armed;
+    if (kind < kinds.size()) ++m->per_kind[kind][1];
+    if (f.isolated) {
+      ++m->isolated;
+      if (kind < kinds.size()) ++m->per_kind[kind][2];
+    }
+    a->delay.push_back(f.delay);
+    if (f.recovered) {
+      ++m->recovered;
+      a->recovery.push_back(f.recovery_delay);
+    }
+  }
+}
+
+/// One method's result on one run of case c: arming, the error of A, false alarms, healthy
+/// hours and the faults' scores.
+void add_method_run(const Case& c, const CaseResult& r, const MethodResult& mr, MethodSummary* m,
+                    Acc* a) {
+  ++m->runs;
+  if (std::isfinite(mr.t_armed)) {
+    ++m->armed_runs;
+    a->arming.push_back(mr.t_armed - r.t_first);
+  }
+  const double ref = c.A_ref.norm();
+  a->a_error.push_back(ref > 0 ? (mr.A_final - c.A_ref).norm() / ref : kNaN);
+  m->false_alarms += static_cast<int>(mr.score.false_alarms());
+  for (double tf : mr.score.false_alarm_times) {
+    if (std::isfinite(mr.t_armed) && tf >= mr.t_armed) ++m->false_alarms_armed;
+  }
+  m->healthy_hours += mr.score.healthy_time / 3600.0;
+  m->healthy_armed_hours += mr.score.healthy_armed_time / 3600.0;
+  add_fault_scores(mr.score.faults, m, a);
+}
+
+void set_quantiles(const Acc& a, MethodSummary* m) {
+  m->delay_median = quantile(a.delay, 0.5);
+  m->delay_p95 = quantile(a.delay, 0.95);
+  m->recovery_median = quantile(a.recovery, 0.5);
+  m->recovery_p95 = quantile(a.recovery, 0.95);
+  m->arming_median = quantile(a.arming, 0.5);
+  m->arming_max = quantile(a.arming, 1.0);
+  m->a_error_median = quantile(a.a_error, 0.5);
+  m->a_error_p95 = quantile(a.a_error, 0.95);
+}
+
+}  // namespace
+
 std::vector<TableSummary> summarise(const std::vector<Case>& cases,
                                     const std::vector<CaseResult>& results) {
   std::vector<TableSummary> tables;
-  auto table_of = [&](const std::string& name) -> TableSummary& {
-    for (TableSummary& t : tables) {
-      if (t.name == name) return t;
-    }
-    tables.push_back(TableSummary{});
-    tables.back().name = name;
-    for (MethodSummary& m : tables.back().m) {
-      m.per_kind.assign(standard_kinds().size(), {0, 0, 0});
-    }
-    return tables.back();
-  };
-  struct Acc {
-    std::vector<double> delay, recovery, arming, a_error;
-  };
   std::vector<std::array<Acc, kMethods>> acc;
   for (const CaseResult& r : results) {
     const Case& c = cases[r.index];
-    TableSummary& t = table_of(c.table);
+    TableSummary& t = table_named(&tables, c.table);
     const std::size_t ti = static_cast<std::size_t>(&t - tables.data());
     if (acc.size() <= ti) acc.resize(ti + 1);
     ++t.runs;
     if (t.note.empty()) t.note = c.note;
     t.hours += (r.t_last - r.t_first) / 3600.0;
-    for (int k = 0; k < kMethods; ++k) {
-      MethodSummary& m = t.m[k];
-      Acc& a = acc[ti][k];
-      const MethodResult& mr = r.m[k];
-      ++m.runs;
-      if (std::isfinite(mr.t_armed)) {
-        ++m.armed_runs;
-        a.arming.push_back(mr.t_armed - r.t_first);
-      }
-      const double ref = c.A_ref.norm();
-      a.a_error.push_back(ref > 0 ? (mr.A_final - c.A_ref).norm() / ref : kNaN);
-      m.false_alarms += static_cast<int>(mr.score.false_alarms());
-      for (double tf : mr.score.false_alarm_times) {
-        if (std::isfinite(mr.t_armed) && tf >= mr.t_armed) ++m.false_alarms_armed;
-      }
-      m.healthy_hours += mr.score.healthy_time / 3600.0;
-      m.healthy_armed_hours += mr.score.healthy_armed_time / 3600.0;
-      for (const FaultScore& f : mr.score.faults) {
-        ++m.faults;
-        const auto& kinds = standard_kinds();
-        const std::size_t kind = static_cast<std::size_t>(
-            std::find(kinds.begin(), kinds.end(), f.fault.kind) - kinds.begin());
-        if (kind < kinds.size()) ++m.per_kind[kind][0];
-        if (f.armed_at_onset) ++m.armed_at_onset;
-        if (!f.detected) continue;
-        ++m.detected;
-        if (f.armed_at_onset) ++m.detected_armed;
-        if (kind < kinds.size()) ++m.per_kind[kind][1];
-        if (f.isolated) {
-          ++m.isolated;
-          if (kind < kinds.size()) ++m.per_kind[kind][2];
-        }
-        a.delay.push_back(f.delay);
-        if (f.recovered) {
-          ++m.recovered;
-          a.recovery.push_back(f.recovery_delay);
-        }
-      }
-    }
+    for (int k = 0; k < kMethods; ++k) add_method_run(c, r, r.m[k], &t.m[k], &acc[ti][k]);
   }
   for (std::size_t ti = 0; ti < tables.size(); ++ti) {
-    for (int k = 0; k < kMethods; ++k) {
-      MethodSummary& m = tables[ti].m[k];
-      const Acc& a = acc[ti][k];
-      m.delay_median = quantile(a.delay, 0.5);
-      m.delay_p95 = quantile(a.delay, 0.95);
-      m.recovery_median = quantile(a.recovery, 0.5);
-      m.recovery_p95 = quantile(a.recovery, 0.95);
-      m.arming_median = quantile(a.arming, 0.5);
-      m.arming_max = quantile(a.arming, 1.0);
-      m.a_error_median = quantile(a.a_error, 0.5);
-      m.a_error_p95 = quantile(a.a_error, 0.95);
-    }
+    for (int k = 0; k < kMethods; ++k) set_quantiles(acc[ti][k], &tables[ti].m[k]);
   }
   return tables;
 }

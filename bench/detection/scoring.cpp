@@ -19,12 +19,10 @@ double overlap(double a, double b, double lo, double hi) {
   return std::max(0.0, std::min(b, hi) - std::max(a, lo));
 }
 
-}  // namespace
-
-RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
-                   double t_first, double t_last, double t_armed, const ScoreParams& params) {
-  std::sort(faults.begin(), faults.end(),
-            [](const InjectedFault& a, const InjectedFault& b) { return a.t_start < b.t_start; });
+/// Throws std::invalid_argument on a fault that ends before it starts, overlapping faults
+/// (sorted by onset), alarms out of time order or a run that ends before it begins.
+void check_run(const std::vector<InjectedFault>& faults, const std::vector<Alarm>& alarms,
+               double t_first, double t_last) {
   for (std::size_t i = 0; i < faults.size(); ++i) {
     if (!(faults[i].t_end > faults[i].t_start)) {
       throw std::invalid_argument("fault " + describe(faults[i]) + ": t_end must exceed t_start");
@@ -41,47 +39,61 @@ RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& 
     }
   }
   if (!(t_last >= t_first)) throw std::invalid_argument("run ends before it begins");
+}
 
-  // Detection windows, each cut at the next onset.
-  const std::size_t n = faults.size();
-  std::vector<double> win_end(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    win_end[i] = faults[i].t_end + params.detect_grace;
-    if (i + 1 < n) win_end[i] = std::min(win_end[i], faults[i + 1].t_start);
-  }
-  auto window_of = [&](double t) -> int {
+/// The detection windows of the faults (sorted by onset), each cut at the next onset.
+class DetectionWindows {
+ public:
+  DetectionWindows(const std::vector<InjectedFault>& faults, double grace) : faults_(faults) {
+    const std::size_t n = faults.size();
+    end_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
-      if (t >= faults[i].t_start && t < win_end[i]) return static_cast<int>(i);
+      end_[i] = faults[i].t_end + grace;
+      if (i + 1 < n) end_[i] = std::min(end_[i], faults[i + 1].t_start);
+    }
+  }
+  double end(std::size_t i) const { return end_[i]; }
+  /// The window that holds t, -1 for none.
+  int of(double t) const {
+    for (std::size_t i = 0; i < faults_.size(); ++i) {
+      if (t >= faults_[i].t_start && t < end_[i]) return static_cast<int>(i);
     }
     return -1;
-  };
+  }
 
-  RunScore out;
-  out.span = t_last - t_first;
-  double windows = 0.0, windows_armed = 0.0;
+ private:
+  const std::vector<InjectedFault>& faults_;
+  std::vector<double> end_;
+};
+
+/// The run's span and its healthy time (outside the windows), in all and after arming.
+void set_healthy_time(const std::vector<InjectedFault>& faults, const DetectionWindows& windows,
+                      double t_first, double t_last, double t_armed, RunScore* out) {
+  out->span = t_last - t_first;
+  double in_windows = 0.0, in_windows_armed = 0.0;
   const bool armed = std::isfinite(t_armed);
   const double arm_from = armed ? std::max(t_armed, t_first) : t_last;
-  for (std::size_t i = 0; i < n; ++i) {
-    windows += overlap(faults[i].t_start, win_end[i], t_first, t_last);
-    windows_armed += overlap(faults[i].t_start, win_end[i], arm_from, t_last);
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    in_windows += overlap(faults[i].t_start, windows.end(i), t_first, t_last);
+    in_windows_armed += overlap(faults[i].t_start, windows.end(i), arm_from, t_last);
   }
-  out.healthy_time = out.span - windows;
-  out.healthy_armed_time = armed ? (t_last - arm_from) - windows_armed : 0.0;
+  out->healthy_time = out->span - in_windows;
+  out->healthy_armed_time = armed ? (t_last - arm_from) - in_windows_armed : 0.0;
+}
 
-  out.faults.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    out.faults[i].fault = faults[i];
-    out.faults[i].armed_at_onset = armed && t_armed <= faults[i].t_start;
-  }
+/// Each raise within the run: the first in a fault's window detects it (delay, isolation);
+/// one outside every window is a false alarm.
+void score_raises(const std::vector<Alarm>& alarms, const DetectionWindows& windows, double t_first,
+                  double t_last, RunScore* out) {
   for (const Alarm& a : alarms) {
     if (!a.raised || a.t < t_first || a.t > t_last) continue;
-    const int w = window_of(a.t);
+    const int w = windows.of(a.t);
     if (w < 0) {
-      out.false_alarm_times.push_back(a.t);
-      out.false_alarm_events.push_back(a);
+      out->false_alarm_times.push_back(a.t);
+      out->false_alarm_events.push_back(a);
       continue;
     }
-    FaultScore& fs = out.faults[static_cast<std::size_t>(w)];
+    FaultScore& fs = out->faults[static_cast<std::size_t>(w)];
     if (fs.detected) continue;
     fs.detected = true;
     fs.delay = a.t - fs.fault.t_start;
@@ -89,31 +101,54 @@ RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& 
     fs.raised_kind = a.kind;
     fs.isolated = a.sensor == fs.fault.sensor;
   }
+}
 
-  // Recovery: replay the conditions.
-  for (std::size_t i = 0; i < n; ++i) {
-    FaultScore& fs = out.faults[i];
-    if (!fs.detected) continue;
-    const double limit = i + 1 < n ? faults[i + 1].t_start : t_last;
-    std::array<bool, 3> raised{false, false, false};
-    auto clear = [&] { return !raised[0] && !raised[1] && !raised[2]; };
-    std::size_t k = 0;
-    for (; k < alarms.size() && alarms[k].t <= fs.fault.t_end; ++k) {
-      raised[static_cast<int>(alarms[k].sensor)] = alarms[k].raised;
-    }
+/// Recovery of a detected fault: the alarm conditions replayed up to its end, then until
+/// every one is clear, at the latest by limit.
+void score_recovery(const std::vector<Alarm>& alarms, double limit, FaultScore* fs) {
+  std::array<bool, 3> raised{false, false, false};
+  auto clear = [&] { return !raised[0] && !raised[1] && !raised[2]; };
+  std::size_t k = 0;
+  for (; k < alarms.size() && alarms[k].t <= fs->fault.t_end; ++k) {
+    raised[static_cast<int>(alarms[k].sensor)] = alarms[k].raised;
+  }
+  if (clear()) {
+    fs->recovered = true;
+    fs->recovery_delay = 0.0;
+    return;
+  }
+  for (; k < alarms.size() && alarms[k].t <= limit; ++k) {
+    raised[static_cast<int>(alarms[k].sensor)] = alarms[k].raised;
     if (clear()) {
-      fs.recovered = true;
-      fs.recovery_delay = 0.0;
-      continue;
+      fs->recovered = true;
+      fs->recovery_delay = alarms[k].t - fs->fault.t_end;
+      return;
     }
-    for (; k < alarms.size() && alarms[k].t <= limit; ++k) {
-      raised[static_cast<int>(alarms[k].sensor)] = alarms[k].raised;
-      if (clear()) {
-        fs.recovered = true;
-        fs.recovery_delay = alarms[k].t - fs.fault.t_end;
-        break;
-      }
-    }
+  }
+}
+
+}  // namespace
+
+RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
+                   double t_first, double t_last, double t_armed, const ScoreParams& params) {
+  std::sort(faults.begin(), faults.end(),
+            [](const InjectedFault& a, const InjectedFault& b) { return a.t_start < b.t_start; });
+  check_run(faults, alarms, t_first, t_last);
+  const DetectionWindows windows(faults, params.detect_grace);
+
+  RunScore out;
+  set_healthy_time(faults, windows, t_first, t_last, t_armed, &out);
+  const std::size_t n = faults.size();
+  out.faults.resize(n);
+  const bool armed = std::isfinite(t_armed);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.faults[i].fault = faults[i];
+    out.faults[i].armed_at_onset = armed && t_armed <= faults[i].t_start;
+  }
+  score_raises(alarms, windows, t_first, t_last, &out);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!out.faults[i].detected) continue;
+    score_recovery(alarms, i + 1 < n ? faults[i + 1].t_start : t_last, &out.faults[i]);
   }
   return out;
 }

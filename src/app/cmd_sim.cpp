@@ -294,10 +294,17 @@ int run_sim(const SimArgs& a) {
     spdlog::error("sim: give --output FILE (or --publish)");
     return kExitUsage;
   }
+#ifdef USV_FDI_APP_WITH_DDS
   if (!targeted.empty() || !a.healthy.empty()) {
     spdlog::error("sim: MMSI@ faults and --healthy only apply with --publish");
     return kExitUsage;
   }
+#else
+  if (!targeted.empty()) {  // --publish and --healthy exist in a build with DDS only
+    spdlog::error("sim: MMSI@ faults only apply with --publish (a build with DDS)");
+    return kExitUsage;
+  }
+#endif
   return write_classic_csv(a, vessel, c);
 }
 

@@ -15,7 +15,6 @@
 #include <set>
 #include <sstream>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -76,6 +75,7 @@ struct Range {
   }
 };
 const Range kAnything{};
+constexpr double kHour = 3600.0;  ///< [s]
 
 /// Parses one YAML document into an EngineConfig; every problem names file, key, line, value.
 class Loader {
@@ -180,163 +180,200 @@ class Loader {
   EngineConfig load(const YAML::Node& root) {
     EngineConfig cfg;
     bool have_b = false;
-    IdentificationParams& id = cfg.identification;
-    IsolationParams& is = cfg.isolation;
+    const Keys model = model_keys(&cfg, &have_b);
+    const Keys identification = identification_keys(&cfg);
+    const Keys isolation = isolation_keys(&cfg.isolation);
+    const Keys jump = jump_keys(&cfg.isolation.jump);
+    const Keys speed = speed_keys(&cfg.speed);
+    const Keys top = document_keys(model, identification, isolation, jump, speed);
 
-    // Each number gets the range within which the engine still detects (checked after the
-    // engine's own validate(), whose messages explain the finer rules).
-    auto num = [this](double* out, Range r) {
-      return [this, out, r](const YAML::Node& n, const std::string& p) { *out = number(n, p, r); };
-    };
-    auto integ = [this](int* out, Range r) {
-      return [this, out, r](const YAML::Node& n, const std::string& p) { *out = integer(n, p, r); };
-    };
-    auto boo = [this](bool* out) {
-      return [this, out](const YAML::Node& n, const std::string& p) { *out = boolean(n, p); };
-    };
-    auto vec2 = [this](Vec2* out, Range r) {
-      return
-          [this, out, r](const YAML::Node& n, const std::string& p) { *out = vector<2>(n, p, r); };
-    };
-    // One of a few names, each standing for a value ("expected a or b" otherwise).
-    auto choice = [this](auto* out,
-                         std::vector<std::pair<std::string, std::decay_t<decltype(*out)>>> names) {
-      return [this, out, names](const YAML::Node& n, const std::string& p) {
-        const std::string m = text(n, p);
-        std::string expected;
-        for (std::size_t i = 0; i < names.size(); ++i) {
-          if (names[i].first == m) {
-            *out = names[i].second;
-            return;
-          }
-          expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i].first;
+    if (!root.IsDefined() || root.IsNull()) fail_missing(root, "model.B");
+    section(root, "", top);
+    if (!have_b) fail_missing(root["model"].IsDefined() ? root["model"] : root, "model.B");
+    validate_and_check_ranges(cfg);
+    return cfg;
+  }
+
+ private:
+  using Keys = std::map<std::string, Handler>;
+
+  // Handlers that parse a value into *out. Each number gets the range within which the
+  // engine still detects (checked after the engine's own validate(), whose messages explain
+  // the finer rules).
+  Handler number_into(double* out, Range r) {
+    return [this, out, r](const YAML::Node& n, const std::string& p) { *out = number(n, p, r); };
+  }
+  Handler integer_into(int* out, Range r) {
+    return [this, out, r](const YAML::Node& n, const std::string& p) { *out = integer(n, p, r); };
+  }
+  Handler boolean_into(bool* out) {
+    return [this, out](const YAML::Node& n, const std::string& p) { *out = boolean(n, p); };
+  }
+  Handler vector2_into(Vec2* out, Range r) {
+    return [this, out, r](const YAML::Node& n, const std::string& p) { *out = vector<2>(n, p, r); };
+  }
+  /// One of a few names, each standing for a value ("expected a or b" otherwise).
+  template <typename T>
+  Handler choice_into(T* out, std::vector<std::pair<std::string, T>> names) {
+    return [this, out, names](const YAML::Node& n, const std::string& p) {
+      const std::string m = text(n, p);
+      std::string expected;
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        if (names[i].first == m) {
+          *out = names[i].second;
+          return;
         }
-        fail(n, p, "expected " + expected);
-      };
+        expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i].first;
+      }
+      fail(n, p, "expected " + expected);
     };
-    constexpr double kHour = 3600.0;
+  }
 
-    const std::map<std::string, Handler> model = {
+  /// `model:`; sets *have_b when B is given.
+  Keys model_keys(EngineConfig* cfg, bool* have_b) {
+    return {
         {"B",
-         [&](const YAML::Node& n, const std::string& p) {
-           cfg.B = vector<2>(n, p, {-1e3, 1e3, "(b1 in m/s^2, b2 in 1/s^2, per rad of rudder)"});
-           have_b = true;
+         [this, cfg, have_b](const YAML::Node& n, const std::string& p) {
+           cfg->B = vector<2>(n, p, {-1e3, 1e3, "(b1 in m/s^2, b2 in 1/s^2, per rad of rudder)"});
+           *have_b = true;
          }},
         {"A0",
-         [&](const YAML::Node& n, const std::string& p) {
-           id.a0 = vector<4>(n, p, {-1e3, 1e3, "1/s"});
+         [this, cfg](const YAML::Node& n, const std::string& p) {
+           cfg->identification.a0 = vector<4>(n, p, {-1e3, 1e3, "1/s"});
            remember(n, "identification.a0");  // the name validate() uses
          }},
         {"reference_speed",
-         num(&cfg.speed.reference_speed, {0, 1e3, "m/s (0: the first measured speed)"})},
+         number_into(&cfg->speed.reference_speed, {0, 1e3, "m/s (0: the first measured speed)"})},
     };
-    const std::map<std::string, Handler> speed = {
-        {"min_ratio", num(&cfg.speed.min_ratio, {0, 1e3, ""})},
-        {"max_ratio", num(&cfg.speed.max_ratio, {0, 1e3, ""})},
-        {"quantum", num(&cfg.speed.quantum, {0, 1, ""})},
-        {"input_exponent", num(&cfg.speed.input_exponent, {0, 3, ""})},
+  }
+
+  Keys speed_keys(SpeedParams* speed) {
+    return {
+        {"min_ratio", number_into(&speed->min_ratio, {0, 1e3, ""})},
+        {"max_ratio", number_into(&speed->max_ratio, {0, 1e3, ""})},
+        {"quantum", number_into(&speed->quantum, {0, 1, ""})},
+        {"input_exponent", number_into(&speed->input_exponent, {0, 3, ""})},
     };
-    const std::map<std::string, Handler> identification = {
-        {"method", choice(&id.method, {{"kreisselmeier", IdentMethod::kKreisselmeier},
-                                       {"paper", IdentMethod::kPaper}})},
-        {"instruments", choice(&id.instruments, {{"rudder", Instruments::kRudder},
-                                                 {"regressor", Instruments::kRegressor}})},
-        {"precision", choice(&id.precision, {{"coefficients", Precision::kCoefficients},
-                                             {"prediction", Precision::kPrediction}})},
-        {"eps1", num(&id.eps1, {1e-3, 1e3, "1/s"})},
-        {"eps2", num(&id.eps2, {1e-3, 1e3, "1/s"})},
-        {"gamma", num(&id.gamma, {0, 1e15, "1/s (paper law: 1/(psi^2 s))"})},
-        {"normalised", boo(&id.normalised)},
-        {"mu", num(&id.mu, {0, 1e3, "excitation^2"})},
-        {"lambda", num(&id.lambda, {0, 10, "1/s"})},
-        {"warmup_time", num(&id.warmup_time, {-1e6, kHour, "s (< 0: automatic)"})},
-        {"max_gap", num(&id.max_gap, {0, kHour, "s"})},
-        {"curvature_correction", boo(&id.curvature_correction)},
-        {"cubic_correction", boo(&id.cubic_correction)},
-        {"min_excitation", num(&id.min_excitation, {0, 1, ""})},
-        {"settle_window", num(&id.settle_window, {0, kHour, "s"})},
-        {"settle_tolerance", num(&id.settle_tolerance, {0, 1, ""})},
-        {"settle_windows", integ(&id.settle_windows, {1, 1000, ""})},
-        {"settle_floor", num(&id.settle_floor, {0, 1e3, "(unit of a_n)"})},
-        {"max_std_error", num(&id.max_std_error, {0, 10, ""})},
-        {"max_prediction_error", num(&id.max_prediction_error, {0, 10, ""})},
-        {"guard", boo(&id.guard)},
-        {"guard_threshold", num(&id.guard_threshold, {0, 1e6, ""})},
-        {"guard_min_shift", num(&id.guard_min_shift, {0, 10, ""})},
-        {"guard_recent_time", num(&id.guard_recent_time, {0, 100 * kHour, "s"})},
-        {"delay", num(&cfg.identification_delay, {0, 60, "s"})},
+  }
+
+  /// `identification:` (IdentificationParams, and the engine's identification delay).
+  Keys identification_keys(EngineConfig* cfg) {
+    IdentificationParams& id = cfg->identification;
+    return {
+        {"method", choice_into(&id.method, {{"kreisselmeier", IdentMethod::kKreisselmeier},
+                                            {"paper", IdentMethod::kPaper}})},
+        {"instruments", choice_into(&id.instruments, {{"rudder", Instruments::kRudder},
+                                                      {"regressor", Instruments::kRegressor}})},
+        {"precision", choice_into(&id.precision, {{"coefficients", Precision::kCoefficients},
+                                                  {"prediction", Precision::kPrediction}})},
+        {"eps1", number_into(&id.eps1, {1e-3, 1e3, "1/s"})},
+        {"eps2", number_into(&id.eps2, {1e-3, 1e3, "1/s"})},
+        {"gamma", number_into(&id.gamma, {0, 1e15, "1/s (paper law: 1/(psi^2 s))"})},
+        {"normalised", boolean_into(&id.normalised)},
+        {"mu", number_into(&id.mu, {0, 1e3, "excitation^2"})},
+        {"lambda", number_into(&id.lambda, {0, 10, "1/s"})},
+        {"warmup_time", number_into(&id.warmup_time, {-1e6, kHour, "s (< 0: automatic)"})},
+        {"max_gap", number_into(&id.max_gap, {0, kHour, "s"})},
+        {"curvature_correction", boolean_into(&id.curvature_correction)},
+        {"cubic_correction", boolean_into(&id.cubic_correction)},
+        {"min_excitation", number_into(&id.min_excitation, {0, 1, ""})},
+        {"settle_window", number_into(&id.settle_window, {0, kHour, "s"})},
+        {"settle_tolerance", number_into(&id.settle_tolerance, {0, 1, ""})},
+        {"settle_windows", integer_into(&id.settle_windows, {1, 1000, ""})},
+        {"settle_floor", number_into(&id.settle_floor, {0, 1e3, "(unit of a_n)"})},
+        {"max_std_error", number_into(&id.max_std_error, {0, 10, ""})},
+        {"max_prediction_error", number_into(&id.max_prediction_error, {0, 10, ""})},
+        {"guard", boolean_into(&id.guard)},
+        {"guard_threshold", number_into(&id.guard_threshold, {0, 1e6, ""})},
+        {"guard_min_shift", number_into(&id.guard_min_shift, {0, 10, ""})},
+        {"guard_recent_time", number_into(&id.guard_recent_time, {0, 100 * kHour, "s"})},
+        {"delay", number_into(&cfg->identification_delay, {0, 60, "s"})},
     };
-    const std::map<std::string, Handler> isolation = {
-        {"poles_v", vec2(&is.poles_v, {-1e3, 0, "1/s"})},
-        {"poles_g", vec2(&is.poles_g, {-1e3, 0, "1/s"})},
-        {"min_observability", num(&is.min_observability, {0, 1, ""})},
-        {"redesign_tolerance", num(&is.redesign_tolerance, {0, 10, ""})},
-        {"sigma_v", num(&is.sigma_v, {0, 20, "m/s"})},
-        {"sigma_r", num(&is.sigma_r, {0, 3, "rad/s"})},
-        {"sigma_floor_v", num(&is.sigma_floor_v, {0, 20, "m/s"})},
-        {"sigma_floor_r", num(&is.sigma_floor_r, {0, 3, "rad/s"})},
-        {"settle_time", num(&is.settle_time, {-1e6, kHour, "s (< 0: automatic)"})},
-        {"learn_time", num(&is.learn_time, {0, 24 * kHour, "s"})},
-        {"window", num(&is.window, {0, 600, "s"})},
-        {"min_window_samples", integ(&is.min_window_samples, {1, 1000000, ""})},
-        {"clip", num(&is.clip, {0, 1e3, ""})},
+  }
+
+  /// `isolation:` (IsolationParams but its jump check, which has a section of its own).
+  Keys isolation_keys(IsolationParams* is) {
+    return {
+        {"poles_v", vector2_into(&is->poles_v, {-1e3, 0, "1/s"})},
+        {"poles_g", vector2_into(&is->poles_g, {-1e3, 0, "1/s"})},
+        {"min_observability", number_into(&is->min_observability, {0, 1, ""})},
+        {"redesign_tolerance", number_into(&is->redesign_tolerance, {0, 10, ""})},
+        {"sigma_v", number_into(&is->sigma_v, {0, 20, "m/s"})},
+        {"sigma_r", number_into(&is->sigma_r, {0, 3, "rad/s"})},
+        {"sigma_floor_v", number_into(&is->sigma_floor_v, {0, 20, "m/s"})},
+        {"sigma_floor_r", number_into(&is->sigma_floor_r, {0, 3, "rad/s"})},
+        {"settle_time", number_into(&is->settle_time, {-1e6, kHour, "s (< 0: automatic)"})},
+        {"learn_time", number_into(&is->learn_time, {0, 24 * kHour, "s"})},
+        {"window", number_into(&is->window, {0, 600, "s"})},
+        {"min_window_samples", integer_into(&is->min_window_samples, {1, 1000000, ""})},
+        {"clip", number_into(&is->clip, {0, 1e3, ""})},
         {"threshold",
-         num(&is.threshold, {0, 1e3, "(whitened mean square; at most 0.75 clip^2 takes effect)"})},
-        {"threshold_margin", num(&is.threshold_margin, {0, 100, ""})},
-        {"threshold_k", num(&is.threshold_k, {0, 1e3, ""})},
-        {"history_margin", num(&is.history_margin, {1, 100, ""})},
-        {"history", num(&is.history, {10, 100 * kHour, "s"})},
-        {"exit_ratio", num(&is.exit_ratio, {0, 1, ""})},
-        {"enter_time", num(&is.enter_time, {0, 60, "s"})},
-        {"leave_time", num(&is.leave_time, {0, kHour, "s"})},
-        {"second_fault_time", num(&is.second_fault_time, {0, kHour, "s"})},
-        {"mismatch_window", num(&is.mismatch_window, {0, kHour, "s"})},
-        {"min_active_time", num(&is.min_active_time, {0, kHour, "s"})},
-        {"c_min", num(&is.c_min, {0, 1, ""})},
-        {"c_margin", num(&is.c_margin, {0, 1, ""})},
-        {"resume_time", num(&is.resume_time, {0, kHour, "s"})},
-        {"resume_after_fault", num(&is.resume_after_fault, {0, kHour, "s"})},
-        {"stale_timeout", num(&is.stale_timeout, {0, kHour, "s"})},
-        {"stuck_time", num(&is.stuck_time, {0, kHour, "s"})},
-        {"stuck_min_samples", integ(&is.stuck_min_samples, {1, 1000000, ""})},
-        {"stuck_probability", num(&is.stuck_probability, {0, 1, ""})},
-        {"stuck_learn_time", num(&is.stuck_learn_time, {0, 1e6, "s"})},
-        {"stuck_time_max", num(&is.stuck_time_max, {0, kHour, "s"})},
-        {"max_abs_v", num(&is.max_abs_v, {0, 1e3, "m/s"})},
-        {"max_abs_r", num(&is.max_abs_r, {0, 100, "rad/s"})},
-        {"max_abs_delta", num(&is.max_abs_delta, {0, 6.3, "rad"})},
-        {"spike_gate", num(&is.spike_gate, {0, 1e3, ""})},
-        {"spike_window", num(&is.spike_window, {0, kHour, "s"})},
-        {"spike_count", integ(&is.spike_count, {1, 1000000, ""})},
-        {"invalid_count", integ(&is.invalid_count, {1, 1000000, ""})},
-        {"classify_window", num(&is.classify_window, {0, kHour, "s"})},
+         number_into(&is->threshold,
+                     {0, 1e3, "(whitened mean square; at most 0.75 clip^2 takes effect)"})},
+        {"threshold_margin", number_into(&is->threshold_margin, {0, 100, ""})},
+        {"threshold_k", number_into(&is->threshold_k, {0, 1e3, ""})},
+        {"history_margin", number_into(&is->history_margin, {1, 100, ""})},
+        {"history", number_into(&is->history, {10, 100 * kHour, "s"})},
+        {"exit_ratio", number_into(&is->exit_ratio, {0, 1, ""})},
+        {"enter_time", number_into(&is->enter_time, {0, 60, "s"})},
+        {"leave_time", number_into(&is->leave_time, {0, kHour, "s"})},
+        {"second_fault_time", number_into(&is->second_fault_time, {0, kHour, "s"})},
+        {"mismatch_window", number_into(&is->mismatch_window, {0, kHour, "s"})},
+        {"min_active_time", number_into(&is->min_active_time, {0, kHour, "s"})},
+        {"c_min", number_into(&is->c_min, {0, 1, ""})},
+        {"c_margin", number_into(&is->c_margin, {0, 1, ""})},
+        {"resume_time", number_into(&is->resume_time, {0, kHour, "s"})},
+        {"resume_after_fault", number_into(&is->resume_after_fault, {0, kHour, "s"})},
+        {"stale_timeout", number_into(&is->stale_timeout, {0, kHour, "s"})},
+        {"stuck_time", number_into(&is->stuck_time, {0, kHour, "s"})},
+        {"stuck_min_samples", integer_into(&is->stuck_min_samples, {1, 1000000, ""})},
+        {"stuck_probability", number_into(&is->stuck_probability, {0, 1, ""})},
+        {"stuck_learn_time", number_into(&is->stuck_learn_time, {0, 1e6, "s"})},
+        {"stuck_time_max", number_into(&is->stuck_time_max, {0, kHour, "s"})},
+        {"max_abs_v", number_into(&is->max_abs_v, {0, 1e3, "m/s"})},
+        {"max_abs_r", number_into(&is->max_abs_r, {0, 100, "rad/s"})},
+        {"max_abs_delta", number_into(&is->max_abs_delta, {0, 6.3, "rad"})},
+        {"spike_gate", number_into(&is->spike_gate, {0, 1e3, ""})},
+        {"spike_window", number_into(&is->spike_window, {0, kHour, "s"})},
+        {"spike_count", integer_into(&is->spike_count, {1, 1000000, ""})},
+        {"invalid_count", integer_into(&is->invalid_count, {1, 1000000, ""})},
+        {"classify_window", number_into(&is->classify_window, {0, kHour, "s"})},
     };
-    JumpParams& jp = is.jump;
-    const std::map<std::string, Handler> jump = {
-        {"enabled", boo(&jp.enabled)},
-        {"pre_window", num(&jp.pre_window, {0, 60, "s"})},
-        {"post_window", num(&jp.post_window, {0, 60, "s"})},
-        {"min_samples", integ(&jp.min_samples, {3, 10000, ""})},
-        {"persist_samples", integ(&jp.persist_samples, {1, 10000, ""})},
-        {"persist_time", num(&jp.persist_time, {0, 60, "s"})},
-        {"threshold", num(&jp.threshold, {1, 1e6, ""})},
-        {"noise_threshold", num(&jp.noise_threshold, {1, 1e6, ""})},
-        {"margin", num(&jp.margin, {1, 100, ""})},
-        {"noise_window", num(&jp.noise_window, {0, 60, "s"})},
-        {"learn_time", num(&jp.learn_time, {0, 24 * kHour, "s"})},
-        {"history", num(&jp.history, {10, 100 * kHour, "s"})},
-        {"scale_time", num(&jp.scale_time, {0, 24 * kHour, "s"})},
-        {"leave_time", num(&jp.leave_time, {0, kHour, "s"})},
-        {"exit_ratio", num(&jp.exit_ratio, {0, 1, ""})},
-        {"hold_max", num(&jp.hold_max, {0, 100 * kHour, "s"})},
-        {"max_gap", num(&jp.max_gap, {0, kHour, "s"})},
-        {"b_uncertainty", num(&jp.b_uncertainty, {0, 100, ""})},
-        {"rudder_lag", num(&jp.rudder_lag, {0, 60, "s"})},
+  }
+
+  /// `jump:` (IsolationParams::jump).
+  Keys jump_keys(JumpParams* jp) {
+    return {
+        {"enabled", boolean_into(&jp->enabled)},
+        {"pre_window", number_into(&jp->pre_window, {0, 60, "s"})},
+        {"post_window", number_into(&jp->post_window, {0, 60, "s"})},
+        {"min_samples", integer_into(&jp->min_samples, {3, 10000, ""})},
+        {"persist_samples", integer_into(&jp->persist_samples, {1, 10000, ""})},
+        {"persist_time", number_into(&jp->persist_time, {0, 60, "s"})},
+        {"threshold", number_into(&jp->threshold, {1, 1e6, ""})},
+        {"noise_threshold", number_into(&jp->noise_threshold, {1, 1e6, ""})},
+        {"margin", number_into(&jp->margin, {1, 100, ""})},
+        {"noise_window", number_into(&jp->noise_window, {0, 60, "s"})},
+        {"learn_time", number_into(&jp->learn_time, {0, 24 * kHour, "s"})},
+        {"history", number_into(&jp->history, {10, 100 * kHour, "s"})},
+        {"scale_time", number_into(&jp->scale_time, {0, 24 * kHour, "s"})},
+        {"leave_time", number_into(&jp->leave_time, {0, kHour, "s"})},
+        {"exit_ratio", number_into(&jp->exit_ratio, {0, 1, ""})},
+        {"hold_max", number_into(&jp->hold_max, {0, 100 * kHour, "s"})},
+        {"max_gap", number_into(&jp->max_gap, {0, kHour, "s"})},
+        {"b_uncertainty", number_into(&jp->b_uncertainty, {0, 100, ""})},
+        {"rudder_lag", number_into(&jp->rudder_lag, {0, 60, "s"})},
     };
-    const auto sub = [this](const std::map<std::string, Handler>& h) {
+  }
+
+  /// The document's top level: the sections above, `service:` (any mapping unless `extra`
+  /// parses it) and every section of `extra`. The sections must outlive the result.
+  Keys document_keys(const Keys& model, const Keys& identification, const Keys& isolation,
+                     const Keys& jump, const Keys& speed) {
+    const auto sub = [this](const Keys& h) {
       return [this, &h](const YAML::Node& n, const std::string& p) { section(n, p, h); };
     };
-    std::map<std::string, Handler> top = {
+    Keys top = {
         {"model", sub(model)},
         {"identification", sub(identification)},
         {"isolation", sub(isolation)},
@@ -359,11 +396,11 @@ class Loader {
         };
       }
     }
+    return top;
+  }
 
-    if (!root.IsDefined() || root.IsNull()) fail_missing(root, "model.B");
-    section(root, "", top);
-    if (!have_b) fail_missing(root["model"].IsDefined() ? root["model"] : root, "model.B");
-
+  /// The engine's validate() (its message located in the file), then every number's range.
+  void validate_and_check_ranges(const EngineConfig& cfg) const {
     try {
       cfg.validate();
     } catch (const std::invalid_argument& e) {
@@ -374,10 +411,7 @@ class Loader {
         fail(c.node, c.path, "outside the allowed range" + c.range.text());
       }
     }
-    return cfg;
   }
-
- private:
   void remember(const YAML::Node& n, const std::string& path) {
     if (n.IsDefined() && n.Mark().line >= 0) seen_[path] = {n.Mark().line + 1, render(n)};
   }

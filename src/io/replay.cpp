@@ -8,98 +8,138 @@
 
 namespace usvfdi::io {
 
-RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& out,
-                  const ReplayOptions& options) {
-  FdiEngine engine(cfg);
-  RunSummary sum;
-  std::vector<FaultEvent> events;
-  double first_t = kNaN, last_t = kNaN, last_record = kNaN;
-  bool last_converged = false, last_armed = false;
-  PlausibilityCheck plausible;
-  FaultState latched[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};
+namespace {
 
-  const auto emit = [&](const FaultEvent& e) {
-    out.event(e);
-    ++sum.events;
+/// One replay: the engine fed row by row, the summary it adds up and the records it writes.
+class Replay {
+ public:
+  Replay(const EngineConfig& cfg, JsonlWriter& out, const ReplayOptions& options)
+      : cfg_(cfg), out_(out), options_(options), engine_(cfg) {}
+
+  /// Feeds one row (read from line `line` of the input) to the engine and writes what it
+  /// changed: events (acknowledged at once with --auto-ack), mismatch and estimate records.
+  void add(const Sample& s, std::size_t line) {
+    ++sum_.samples;
+    plausible_.add(s);
+    events_.clear();
+    const bool accepted = engine_.process(s, &events_);
+    if (!accepted) count_dropped(s, line);
+    for (const FaultEvent& e : events_) {
+      emit(e);
+      if (options_.auto_ack) acknowledge(e, s.t);
+    }
+    if (!std::isfinite(s.t)) return;
+    if (std::isnan(first_t_)) first_t_ = s.t;
+    if (std::isnan(last_t_) || s.t > last_t_) last_t_ = s.t;
+    record_mismatch(s.t);
+    record_estimate(s.t);
+  }
+
+  /// The final estimate record and the summary's totals (the caller writes the summary).
+  RunSummary& finish() {
+    if (!std::isnan(last_t_)) {
+      out_.estimate(last_t_, engine_.estimate(), engine_.isolation_status().armed);
+    }
+    sum_.final_a = to_params(engine_.estimate().A);
+    sum_.converged = engine_.estimate().converged;
+    sum_.frozen_samples = engine_.frozen_samples();
+    sum_.duration_s = std::isnan(first_t_) ? 0.0 : last_t_ - first_t_;
+    sum_.warnings = plausible_.warnings();
+    sum_.not_converged = convergence_report(engine_.estimate(), cfg_.identification);
+    return sum_;
+  }
+
+ private:
+  /// A row the engine did not take: counted as a duplicate or as rejected, with the first
+  /// line of each.
+  void count_dropped(const Sample& s, std::size_t line) {
+    if (engine_.last_was_duplicate()) {
+      ++sum_.duplicates;  // the previous row once more: dropped, not an error
+      if (sum_.first_duplicate_line == 0) sum_.first_duplicate_line = line;
+      return;
+    }
+    ++sum_.rejected;
+    if (!std::isfinite(s.t)) ++sum_.rejected_no_time;
+    if (sum_.first_rejected_line == 0) {
+      sum_.first_rejected_line = line;
+      sum_.first_rejected_t = s.t;
+      sum_.first_rejected_after = last_t_;
+    }
+  }
+
+  void emit(const FaultEvent& e) {
+    out_.event(e);
+    ++sum_.events;
     // A raise is a transition into raised; a refined kind republishes raised and is no raise.
-    FaultState& before = latched[static_cast<int>(e.sensor)];
+    FaultState& before = latched_[static_cast<int>(e.sensor)];
     if (e.state == FaultState::kRaised && before != FaultState::kRaised) {
-      ++sum.raised[static_cast<int>(e.sensor)];
+      ++sum_.raised[static_cast<int>(e.sensor)];
     }
     before = e.state;
-  };
-  const auto finish = [&] {
-    if (!std::isnan(last_t)) {
-      out.estimate(last_t, engine.estimate(), engine.isolation_status().armed);
-    }
-    sum.final_a = to_params(engine.estimate().A);
-    sum.converged = engine.estimate().converged;
-    sum.frozen_samples = engine.frozen_samples();
-    sum.duration_s = std::isnan(first_t) ? 0.0 : last_t - first_t;
-    sum.warnings = plausible.warnings();
-    sum.not_converged = convergence_report(engine.estimate(), cfg.identification);
-  };
+  }
 
-  bool last_mismatch = false;
+  /// --auto-ack: a raised or cleared event acknowledged at once, as an attentive operator would.
+  void acknowledge(const FaultEvent& e, double t) {
+    if (e.state != FaultState::kRaised && e.state != FaultState::kClearedUnacknowledged) return;
+    FaultEvent ack;
+    if (engine_.acknowledge(e.sensor, e.sequence, t, "replay --auto-ack", &ack) ==
+        AckResult::kAccepted) {
+      emit(ack);
+    }
+  }
+
+  /// Model mismatch: reported, counted, never a latched sensor fault.
+  void record_mismatch(double t) {
+    const IsolatorStatus& iso = engine_.isolation_status();
+    if (iso.model_mismatch != last_mismatch_) {
+      out_.mismatch(t, iso.model_mismatch, iso.mismatch_reason);
+      last_mismatch_ = iso.model_mismatch;
+    }
+    sum_.model_mismatches = iso.mismatches;
+  }
+
+  /// An estimate record every estimate_period, and whenever convergence or arming changes.
+  void record_estimate(double t) {
+    const bool converged = engine_.estimate().converged;
+    const bool armed = engine_.isolation_status().armed;
+    if (std::isnan(last_record_) || t >= last_record_ + options_.estimate_period ||
+        converged != last_converged_ || armed != last_armed_) {
+      out_.estimate(t, engine_.estimate(), armed);
+      last_record_ = t;
+      last_converged_ = converged;
+      last_armed_ = armed;
+    }
+  }
+
+  const EngineConfig& cfg_;
+  JsonlWriter& out_;
+  const ReplayOptions& options_;
+  FdiEngine engine_;
+  RunSummary sum_;
+  std::vector<FaultEvent> events_;
+  double first_t_ = kNaN, last_t_ = kNaN, last_record_ = kNaN;
+  bool last_converged_ = false, last_armed_ = false, last_mismatch_ = false;
+  PlausibilityCheck plausible_;
+  FaultState latched_[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};
+};
+
+}  // namespace
+
+RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& out,
+                  const ReplayOptions& options) {
+  Replay run(cfg, out, options);
   Sample s;
   try {
-    while (input.next(&s)) {
-      ++sum.samples;
-      plausible.add(s);
-      events.clear();
-      const bool accepted = engine.process(s, &events);
-      if (!accepted && engine.last_was_duplicate()) {
-        ++sum.duplicates;  // the previous row once more: dropped, not an error
-        if (sum.first_duplicate_line == 0) sum.first_duplicate_line = input.line();
-      } else if (!accepted) {
-        ++sum.rejected;
-        if (!std::isfinite(s.t)) ++sum.rejected_no_time;
-        if (sum.first_rejected_line == 0) {
-          sum.first_rejected_line = input.line();
-          sum.first_rejected_t = s.t;
-          sum.first_rejected_after = last_t;
-        }
-      }
-      for (const FaultEvent& e : events) {
-        emit(e);
-        if (options.auto_ack &&
-            (e.state == FaultState::kRaised || e.state == FaultState::kClearedUnacknowledged)) {
-          FaultEvent ack;
-          if (engine.acknowledge(e.sensor, e.sequence, s.t, "replay --auto-ack", &ack) ==
-              AckResult::kAccepted) {
-            emit(ack);
-          }
-        }
-      }
-      if (!std::isfinite(s.t)) continue;
-      if (std::isnan(first_t)) first_t = s.t;
-      if (std::isnan(last_t) || s.t > last_t) last_t = s.t;
-      const IsolatorStatus& iso = engine.isolation_status();
-      if (iso.model_mismatch != last_mismatch) {
-        // Model mismatch: reported, counted, never a latched sensor fault.
-        out.mismatch(s.t, iso.model_mismatch, iso.mismatch_reason);
-        last_mismatch = iso.model_mismatch;
-      }
-      sum.model_mismatches = iso.mismatches;
-      const bool converged = engine.estimate().converged;
-      const bool armed = iso.armed;
-      if (std::isnan(last_record) || s.t >= last_record + options.estimate_period ||
-          converged != last_converged || armed != last_armed) {
-        out.estimate(s.t, engine.estimate(), armed);
-        last_record = s.t;
-        last_converged = converged;
-        last_armed = armed;
-      }
-    }
+    while (input.next(&s)) run.add(s, input.line());
   } catch (const InputError& e) {
-    finish();
+    RunSummary& sum = run.finish();
     sum.complete = false;
     sum.error = e.what();
     out.summary(sum);
     out.flush();
     throw;
   }
-  finish();
+  const RunSummary& sum = run.finish();
   out.summary(sum);
   out.flush();
   return sum;
