@@ -236,7 +236,7 @@ void Isolator::sensor_checks(const Sample& s, std::vector<Detection>* out) {
   st_.input.v_ok = ok(0) && !(sens_[0].cond.sources & kStuck);
   st_.input.r_ok = ok(1) && !(sens_[1].cond.sources & kStuck);
   st_.input.delta_ok = ok(2);
-  if (std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta) last_delta_ = s.delta;
+  if (within(s.delta, p_.max_abs_delta)) last_delta_ = s.delta;
   // Timing errors age out of the unknown channel too.
   if ((sens_[2].cond.sources & kInvalid) && checks_.timing_clear(s.t)) {
     set_condition(Sensor::kUnknown, kInvalid, false, FaultKind::kInvalid, s.t,
@@ -260,11 +260,9 @@ void Isolator::jump_checks(const Sample& s, std::vector<Detection>* out) {
 void Isolator::update_jump_checks(const Sample& s, JumpVerdict verdict[2]) {
   const double values[2] = {s.v, s.r};
   const double limits[2] = {p_.max_abs_v, p_.max_abs_r};
-  const double delta =
-      std::isfinite(s.delta) && std::abs(s.delta) <= p_.max_abs_delta ? s.delta : kNaN;
+  const double delta = within(s.delta, p_.max_abs_delta) ? s.delta : kNaN;
   for (int c = 0; c < 2; ++c) {
-    const double y =
-        std::isfinite(values[c]) && std::abs(values[c]) <= limits[c] ? values[c] : kNaN;
+    const double y = within(values[c], limits[c]) ? values[c] : kNaN;
     // Learns from a channel no condition is raised on, with the rudder known.
     const bool learn_ok =
         !sens_[c].cond.active && st_.input.delta_ok && (c == kV ? st_.input.v_ok : st_.input.r_ok);

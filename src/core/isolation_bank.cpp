@@ -111,7 +111,6 @@ std::size_t Isolator::window_samples(double dt) const {
 }
 
 void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok) {
-  const auto usable = [&](double x, double lim) { return std::isfinite(x) && std::abs(x) <= lim; };
   if (dt > p_.stale_timeout) {
     // A gap: restart the observers from the measurements and let them settle again (the
     // monitors stop: the cross residual alone holds a raised fault after a gap).
@@ -130,16 +129,16 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
     b->settle_until = s.t + settle;
     return;
   }
-  const double d = usable(prev_.delta, p_.max_abs_delta) ? prev_.delta
+  const double d = within(prev_.delta, p_.max_abs_delta) ? prev_.delta
                    : std::isfinite(last_delta_)          ? last_delta_
                                                          : 0.0;
-  const double d_new = usable(s.delta, p_.max_abs_delta) ? s.delta : d;
+  const double d_new = within(s.delta, p_.max_abs_delta) ? s.delta : d;
   // While a sensor is faulty, its dedicated observer is driven by the other observer's
   // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
   // the fault stays fully visible and the residual is clean the moment the fault ends.
   const bool fa = sens_[0].cond.active, fg = sens_[1].cond.active;
-  const bool pv = usable(prev_.v, p_.max_abs_v) && !fa;
-  const bool pr = usable(prev_.r, p_.max_abs_r) && !fg;
+  const bool pv = within(prev_.v, p_.max_abs_v) && !fa;
+  const bool pr = within(prev_.r, p_.max_abs_r) && !fg;
   const double yv = pv ? prev_.v : b->g.x()(0);
   const double yr = pr ? prev_.r : b->v.x()(1);
   const bool use_v = pv || (fa && !fg);
@@ -227,10 +226,9 @@ void Isolator::propagate_observers(const Sample& s, double dt, bool v_ok, bool r
   // driving measurements those of t_{k-1}.
   propagate(&act_, s, dt, v_ok, r_ok);
   if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok);
-  const double dp = std::isfinite(prev_.delta) && std::abs(prev_.delta) <= p_.max_abs_delta
-                        ? prev_.delta
-                    : std::isfinite(last_delta_) ? last_delta_
-                                                 : 0.0;
+  const double dp = within(prev_.delta, p_.max_abs_delta) ? prev_.delta
+                    : std::isfinite(last_delta_)          ? last_delta_
+                                                          : 0.0;
   const double dn = within(s.delta, p_.max_abs_delta) ? s.delta : dp;
   for (int c = 0; c < 2; ++c) {
     if (!chan_[c].mon_on) continue;
