@@ -142,12 +142,4 @@ Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, Side f
   return z;
 }
 
-TurningCircle turning_circle(const Hull& hull, double u0, double rudder, double dt) {
-  return turning_circle(hull, u0, rudder, Side::kStarboard, dt);
-}
-
-Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, double dt) {
-  return zigzag(hull, u0, rudder, heading, Side::kStarboard, dt);
-}
-
 }  // namespace usvfdi::sim

@@ -47,10 +47,8 @@ struct TurningCircle {
   double steady_yaw_rate = 0.0;    ///< [rad/s] (+ to starboard: < 0 in a port turn)
   double approach_speed = 0.0;     ///< [m/s]
 };
-TurningCircle turning_circle(const Hull& hull, double u0, double rudder, Side side,
-                             double dt = 0.05);
-/// The turning circle to starboard.
-TurningCircle turning_circle(const Hull& hull, double u0, double rudder, double dt = 0.05);
+TurningCircle turning_circle(const Hull& hull, double u0, double rudder,
+                             Side side = Side::kStarboard, double dt = 0.05);
 
 /// The rudder/heading zigzag (10/10, 20/20), first execute to `first`. Overshoots are
 /// measured past the switching heading on each side (> 0 for either first side).
@@ -59,9 +57,7 @@ struct Zigzag {
   double second_overshoot = 0.0;        ///< [rad]
   double time_to_second_execute = 0.0;  ///< [s] (the "initial turning time" ends earlier)
 };
-Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, Side first,
-              double dt = 0.05);
-/// The zigzag with the first execute to starboard.
-Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading, double dt = 0.05);
+Zigzag zigzag(const Hull& hull, double u0, double rudder, double heading,
+              Side first = Side::kStarboard, double dt = 0.05);
 
 }  // namespace usvfdi::sim
