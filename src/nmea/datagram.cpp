@@ -79,6 +79,8 @@ Result<TagBlock> parse_tag_block(std::string_view block) {
   }
   for (char c : block) {
     if (!is_printable(c)) return bad_tag("TAG block: non-printable byte " + quote_char(c));
+    if (is_reserved(c) && c != '*')
+      return bad_tag("TAG block: reserved character " + quote_char(c));
   }
   const std::size_t star = block.find('*');
   if (star == std::string_view::npos) return bad_tag("TAG block without '*hh' checksum");
@@ -163,7 +165,7 @@ namespace {
 
 bool tag_value_ok(const std::string& v) {
   for (char c : v) {
-    if (!is_printable(c) || is_reserved(c) || c == ',' || c == ':') return false;
+    if (!is_printable(c) || is_reserved(c) || c == ',') return false;
   }
   return true;
 }
@@ -191,13 +193,19 @@ Result<std::string> format_tag_block(const TagBlock& tag) {
     return true;
   };
   if (!add_text('s', tag.source) || !add_text('d', tag.destination)) {
-    return bad_tag("TAG s: or d: with a reserved, non-printable, ',' or ':' character");
+    return bad_tag("TAG s: or d: with a reserved, non-printable or ',' character");
   }
   if (!add_number('n', tag.line_count)) return bad_tag("TAG n: negative");
   if (tag.unix_time_ms) {
     const std::int64_t ms = *tag.unix_time_ms;
-    if (ms < 0) return bad_tag("TAG c: negative");
-    add('c', ms % 1000 == 0 ? std::to_string(ms / 1000) : std::to_string(ms));
+    // Whole seconds below the threshold are written in seconds; the rest in milliseconds,
+    // which read back as milliseconds only from the threshold on.
+    const bool seconds = ms % 1000 == 0 && ms / 1000 < kMillisecondThreshold;
+    if (ms < 0 || (!seconds && ms < kMillisecondThreshold)) {
+      return bad_tag("TAG c: " + std::to_string(ms) +
+                     " ms is negative, or a fraction of a second before 1970-04-26");
+    }
+    add('c', seconds ? std::to_string(ms / 1000) : std::to_string(ms));
   }
   if (tag.group) {
     const TagGroup& g = *tag.group;
@@ -206,7 +214,7 @@ Result<std::string> format_tag_block(const TagBlock& tag) {
   }
   if (!add_number('r', tag.relative_time)) return bad_tag("TAG r: negative");
   if (!add_text('t', tag.text)) {
-    return bad_tag("TAG t: with a reserved, non-printable, ',' or ':' character");
+    return bad_tag("TAG t: with a reserved, non-printable or ',' character");
   }
   std::string block = params + "*" + hex_byte(checksum(params));
   if (block.size() > kMaxTagBlockLength) {

@@ -44,6 +44,24 @@ TEST(Datagram, TagTimeInMillisecondsWhenElevenDigitsOrMore) {
   EXPECT_EQ(ok.value().unix_time_ms, 1700000000123);
 }
 
+TEST(Datagram, TagTimeRoundTripsInSecondsAndMilliseconds) {
+  for (std::int64_t ms : {std::int64_t{0}, std::int64_t{1700000000000}, std::int64_t{1700000000001},
+                          std::int64_t{10000000000}, std::int64_t{10000000000000}}) {
+    TagBlock t;
+    t.unix_time_ms = ms;
+    auto f = format_tag_block(t);
+    ASSERT_TRUE(f.ok()) << ms << ": " << f.rejection().text;
+    auto back = parse_tag_block(f.value().substr(1, f.value().size() - 2));
+    ASSERT_TRUE(back.ok()) << f.value();
+    EXPECT_EQ(back.value().unix_time_ms, ms) << f.value();
+  }
+  TagBlock colon;
+  colon.source = "a:b";  // the value is what follows the first ':'
+  auto f = format_tag_block(colon);
+  ASSERT_TRUE(f.ok());
+  EXPECT_EQ(parse_tag_block(f.value().substr(1, f.value().size() - 2)).value(), colon);
+}
+
 TEST(Datagram, TagDestinationGroupRelativeText) {
   TagBlock t;
   t.source = "II0003";
@@ -128,6 +146,8 @@ TEST(Datagram, RejectsBadTagBlocks) {
   EXPECT_EQ(line_reason(with_sum("g:1-2-x")), Reason::kBadTagBlock);
   EXPECT_EQ(line_reason(with_sum("s:" + std::string(80, 'A'))), Reason::kTooLong);
   EXPECT_EQ(line_reason("\\s:A\x01*00\\$GPHDT,72.14,T*35"), Reason::kBadTagBlock);
+  EXPECT_EQ(line_reason(with_sum("s:A$B")), Reason::kBadTagBlock);  // reserved character
+  EXPECT_EQ(line_reason(with_sum("t:A~B")), Reason::kBadTagBlock);
   // A good TAG block does not save a bad sentence.
   EXPECT_EQ(line_reason(kTag + "$GPHDT,72.14,T*36"), Reason::kChecksumMismatch);
 }
@@ -160,8 +180,14 @@ TEST(Datagram, FormatRefusesBadTagValues) {
   TagBlock t;
   t.source = "GP,01";
   EXPECT_EQ(format_tag_block(t).rejection().reason, Reason::kBadTagBlock);
-  t.source = "GP:01";
+  t.source = "GP$01";
   EXPECT_EQ(format_tag_block(t).rejection().reason, Reason::kBadTagBlock);
+  t.source.reset();
+  t.unix_time_ms = 1500;  // a fraction of a second before 1970-04-26: would read back as s
+  EXPECT_EQ(format_tag_block(t).rejection().reason, Reason::kBadTagBlock);
+  t.unix_time_ms = -1000;
+  EXPECT_EQ(format_tag_block(t).rejection().reason, Reason::kBadTagBlock);
+  t.unix_time_ms.reset();
   t.source.reset();
   t.line_count = -1;
   EXPECT_EQ(format_tag_block(t).rejection().reason, Reason::kBadTagBlock);

@@ -89,9 +89,10 @@ Result<TaggedSentence> parse_tagged_sentence(std::string_view line);
 Result<Datagram> parse_datagram(std::string_view bytes);
 
 /// "\s:SRC,n:12,c:1700000000*hh\" for the parameters present, in the order s d n c g r t;
-/// c in seconds when unix_time_ms is a whole second, else in milliseconds (read back as
-/// milliseconds for any time after 1970-04-26). Refused: a negative number, a value with a
-/// reserved, non-printable, ',' or ':' character, or a block over kMaxTagBlockLength.
+/// c in seconds when unix_time_ms is a whole second (below 1e10 s), else in milliseconds (read
+/// back as milliseconds only from 1e10 ms, 1970-04-26, on). Refused: a negative number, a
+/// fraction of a second before 1970-04-26, a value with a reserved, non-printable or ','
+/// character, or a block over kMaxTagBlockLength.
 Result<std::string> format_tag_block(const TagBlock& tag);
 
 /// An IEC 61162-450 datagram: the header, then each sentence (already formatted, with CR LF)
