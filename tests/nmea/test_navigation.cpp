@@ -268,12 +268,17 @@ TEST(Navigation, FormattersRefuseWhatParsersRefuse) {
 }
 
 // The signs the sidecar will rely on (issue 12): ROT and VBW keep the project's sign, RSA is
-// opposite to delta (delta > 0 turns the bow to port on the shipped vessels: b2 < 0).
+// opposite to delta on the shipped vessels (delta > 0 turns the bow to port: b2 < 0).
 TEST(Navigation, ConversionsToProjectConventions) {
-  EXPECT_NEAR(yaw_rate_from_rot(60.0), kPi / 180.0, 1e-15);       // 60 deg/min = 1 deg/s starboard
-  EXPECT_LT(yaw_rate_from_rot(-30.0), 0.0);                       // bow to port: r < 0
-  EXPECT_NEAR(delta_from_rsa(10.0), -10.0 * kPi / 180.0, 1e-15);  // RSA > 0: bow to starboard
-  EXPECT_GT(delta_from_rsa(-5.0), 0.0);  // RSA "-" = bow to port = delta > 0
+  EXPECT_NEAR(yaw_rate_from_rot(60.0), kPi / 180.0, 1e-15);  // 60 deg/min = 1 deg/s starboard
+  EXPECT_LT(yaw_rate_from_rot(-30.0), 0.0);                  // bow to port: r < 0
+  const RudderSign shipped = rudder_sign_from_b2(-2.19400);  // config/vessels/otter.yaml
+  EXPECT_EQ(shipped, RudderSign::kPositiveToPort);
+  EXPECT_EQ(rudder_sign_from_b2(-3.74282e-3), RudderSign::kPositiveToPort);  // mariner.yaml
+  EXPECT_NEAR(delta_from_rsa(10.0, shipped), -10.0 * kPi / 180.0, 1e-15);    // RSA > 0: starboard
+  EXPECT_GT(delta_from_rsa(-5.0, shipped), 0.0);  // RSA "-" = bow to port = delta > 0
+  EXPECT_EQ(rudder_sign_from_b2(0.5), RudderSign::kPositiveToStarboard);  // container, kvlcc2
+  EXPECT_GT(delta_from_rsa(10.0, RudderSign::kPositiveToStarboard), 0.0);
   EXPECT_NEAR(speed_from_knots(1.0), 0.514444, 1e-6);
   EXPECT_LT(speed_from_knots(-0.3), 0.0);  // VBW transverse "-" = port: v < 0
 }

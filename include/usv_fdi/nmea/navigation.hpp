@@ -15,9 +15,12 @@
 //                           status. "Relative measurement of rudder angle without units,
 //                           '-' = bow turns to port. Sensor output is proportional to rudder
 //                           angle but not necessarily 1:1." Read here as degrees.
-//                           SIGN: RSA > 0 turns the bow to STARBOARD. The project's delta
-//                           (config/vessels/*.yaml: b2 < 0, so delta > 0 gives r < 0, a turn to
-//                           port) has the OPPOSITE sign: delta [rad] = -RSA [deg] * pi / 180.
+//                           SIGN: RSA > 0 turns the bow to STARBOARD. The engine's delta has
+//                           the sign of the vessel model's B (docs/vessels.md, "Sign of delta
+//                           per hull"): in the shipped configurations (config/vessels/otter.yaml,
+//                           mariner.yaml: b2 < 0) delta > 0 gives r < 0, a turn to PORT, the
+//                           OPPOSITE of RSA: delta [rad] = -RSA [deg] * pi / 180. Hulls with
+//                           b2 > 0 (container, kvlcc2) share RSA's sign. See delta_from_rsa.
 //   $--HDT,x.x,T            heading, degrees true
 //   $--THS,x.x,a            true heading; mode A autonomous, E estimated (dead reckoning),
 //                           M manual input, S simulator, V not valid
@@ -64,7 +67,7 @@ struct Rot {
   }
 };
 
-/// $--RSA: rudder sensor angle (see the sign note above: opposite to the project's delta).
+/// $--RSA: rudder sensor angle (see the sign note above: opposite to the shipped vessels' delta).
 struct Rsa {
   std::string talker = "AG";
   std::optional<double> starboard_deg;  ///< starboard or single rudder; "-" = bow turns to port
@@ -180,8 +183,7 @@ Sentence to_sentence(const Vbw& x);
 Sentence to_sentence(const Vtg& x);
 
 // Conversions to the project's quantities and signs (include/usv_fdi/core/types.hpp: v and r
-// positive to starboard, SI units; delta > 0 turns the bow to port, as B's b2 < 0 says for the
-// shipped vessels).
+// positive to starboard, SI units; the sign of delta is the vessel model's, see RudderSign).
 
 /// Metres per second in one knot (1852 m / 3600 s).
 constexpr double kMetresPerSecondPerKnot = 1852.0 / 3600.0;
@@ -189,8 +191,20 @@ constexpr double kPi = 3.14159265358979323846;
 
 /// r [rad/s], > 0 bow to starboard, from ROT [deg/min] ("-" = bow to port): the same sign.
 inline double yaw_rate_from_rot(double deg_per_min) { return deg_per_min * kPi / (180.0 * 60.0); }
-/// delta [rad], > 0 bow to port, from RSA [deg] ("-" = bow to port): the OPPOSITE sign.
-inline double delta_from_rsa(double rsa_deg) { return -rsa_deg * kPi / 180.0; }
+/// Which way a positive delta of the vessel model turns the bow.
+enum class RudderSign {
+  kPositiveToPort,       ///< b2 < 0: otter, mariner (the shipped configurations), coaster, ...
+  kPositiveToStarboard,  ///< b2 > 0: container, kvlcc2 (docs/vessels.md)
+};
+/// The sign of a model whose B = [b1, b2] (r positive to starboard): b2 < 0 turns to port.
+inline RudderSign rudder_sign_from_b2(double b2) {
+  return b2 < 0.0 ? RudderSign::kPositiveToPort : RudderSign::kPositiveToStarboard;
+}
+/// delta [rad] from RSA [deg] ("-" = bow to port): the opposite sign for kPositiveToPort.
+inline double delta_from_rsa(double rsa_deg, RudderSign sign) {
+  const double rad = rsa_deg * kPi / 180.0;
+  return sign == RudderSign::kPositiveToPort ? -rad : rad;
+}
 /// v or u [m/s] from a VBW/VTG speed [kn]: the same sign (VBW transverse "-" = port, v > 0 to
 /// starboard; longitudinal "-" = astern, u > 0 ahead).
 inline double speed_from_knots(double kn) { return kn * kMetresPerSecondPerKnot; }
