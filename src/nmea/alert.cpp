@@ -122,6 +122,23 @@ std::optional<Rejection> read_command(const Sentence& s, std::size_t i, const ch
   return std::nullopt;
 }
 
+/// Fields 1-5 of ARC and ACN: time, manufacturer mnemonic, alert identifier, instance, command.
+std::optional<Rejection> read_alert_command(const Sentence& s, const char* what,
+                                            std::optional<UtcTime>* time, AlertIdentity* alert,
+                                            AlertCommand* command) {
+  if (auto bad = read_time(s, 0, time)) return bad;
+  if (auto bad = read_identity(s, 1, alert)) return bad;
+  return read_command(s, 4, what, command);
+}
+
+std::vector<std::string> write_alert_command(const std::optional<UtcTime>& time,
+                                             const AlertIdentity& alert, AlertCommand command) {
+  std::vector<std::string> f{format_time(time)};
+  write_identity(alert, &f);
+  f.push_back(std::string(1, static_cast<char>(command)));
+  return f;
+}
+
 bool needs_escape(char c) { return is_reserved(c) || c == ',' || c == '^'; }
 
 /// The text as written in a field: '^hh' for reserved characters, ',' and '^'; '?' for a
@@ -161,13 +178,6 @@ std::optional<Rejection> decode_text(const Sentence& s, std::size_t i, std::stri
     j += 2;
   }
   return std::nullopt;
-}
-
-Sentence make(const std::string& talker, const char* formatter) {
-  Sentence s;
-  s.talker = talker;
-  s.formatter = formatter;
-  return s;
 }
 
 }  // namespace
@@ -252,9 +262,9 @@ Result<Arc> parse_arc(const Sentence& s) {
   if (auto bad = fields::expect(s, "ARC", 5, 5)) return *bad;
   Arc x;
   x.talker = s.talker;
-  if (auto bad = read_time(s, 0, &x.time)) return *bad;
-  if (auto bad = read_identity(s, 1, &x.alert)) return *bad;
-  if (auto bad = read_command(s, 4, "refused command", &x.refused)) return *bad;
+  if (auto bad = read_alert_command(s, "refused command", &x.time, &x.alert, &x.refused)) {
+    return *bad;
+  }
   return x;
 }
 
@@ -262,9 +272,9 @@ Result<Acn> parse_acn(const Sentence& s) {
   if (auto bad = fields::expect(s, "ACN", 6, 6)) return *bad;
   Acn x;
   x.talker = s.talker;
-  if (auto bad = read_time(s, 0, &x.time)) return *bad;
-  if (auto bad = read_identity(s, 1, &x.alert)) return *bad;
-  if (auto bad = read_command(s, 4, "alert command", &x.command)) return *bad;
+  if (auto bad = read_alert_command(s, "alert command", &x.time, &x.alert, &x.command)) {
+    return *bad;
+  }
   if (s.fields[5] != "C") {
     return reject(Reason::kBadField, name(5, "sentence status flag") + ": '" + s.fields[5] +
                                          "' is not C: not a command");
@@ -273,7 +283,7 @@ Result<Acn> parse_acn(const Sentence& s) {
 }
 
 Sentence to_sentence(const Alf& x) {
-  Sentence s = make(x.talker, "ALF");
+  Sentence s = fields::make_sentence(x.talker, "ALF");
   s.fields = {std::to_string(x.total_sentences),
               std::to_string(x.sentence_number),
               std::to_string(x.message_id),
@@ -289,7 +299,7 @@ Sentence to_sentence(const Alf& x) {
 }
 
 Sentence to_sentence(const Alc& x) {
-  Sentence s = make(x.talker, "ALC");
+  Sentence s = fields::make_sentence(x.talker, "ALC");
   s.fields = {std::to_string(x.total_sentences), std::to_string(x.sentence_number),
               std::to_string(x.message_id), std::to_string(x.entries.size())};
   for (const auto& e : x.entries) {
@@ -300,25 +310,21 @@ Sentence to_sentence(const Alc& x) {
 }
 
 Sentence to_sentence(const Hbt& x) {
-  Sentence s = make(x.talker, "HBT");
+  Sentence s = fields::make_sentence(x.talker, "HBT");
   s.fields = {fields::format_number(x.interval_s), x.normal ? "A" : "V",
               std::to_string(x.sequence)};
   return s;
 }
 
 Sentence to_sentence(const Arc& x) {
-  Sentence s = make(x.talker, "ARC");
-  s.fields = {format_time(x.time)};
-  write_identity(x.alert, &s.fields);
-  s.fields.push_back(std::string(1, static_cast<char>(x.refused)));
+  Sentence s = fields::make_sentence(x.talker, "ARC");
+  s.fields = write_alert_command(x.time, x.alert, x.refused);
   return s;
 }
 
 Sentence to_sentence(const Acn& x) {
-  Sentence s = make(x.talker, "ACN");
-  s.fields = {format_time(x.time)};
-  write_identity(x.alert, &s.fields);
-  s.fields.push_back(std::string(1, static_cast<char>(x.command)));
+  Sentence s = fields::make_sentence(x.talker, "ACN");
+  s.fields = write_alert_command(x.time, x.alert, x.command);
   s.fields.push_back("C");
   return s;
 }

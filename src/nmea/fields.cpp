@@ -123,6 +123,13 @@ std::optional<Rejection> unit(const Sentence& s, std::size_t index, const char* 
                 name(index, what) + ": '" + text + "' where '" + std::string(unit) + "' belongs");
 }
 
+Sentence make_sentence(const std::string& talker, const char* formatter) {
+  Sentence s;
+  s.talker = talker;
+  s.formatter = formatter;
+  return s;
+}
+
 std::string format_number(const std::optional<double>& value) {
   if (!value) return {};
   char buf[400];

@@ -38,12 +38,20 @@ std::optional<Rejection> letter(const Sentence& s, std::size_t index, const char
 std::optional<Rejection> unit(const Sentence& s, std::size_t index, const char* what,
                               std::string_view unit);
 
+/// An empty sentence of this talker and formatter (for to_sentence).
+Sentence make_sentence(const std::string& talker, const char* formatter);
+
 /// Shortest decimal text that reads back to the same double (fixed notation, no exponent).
 std::string format_number(const std::optional<double>& value);
 /// Decimal digits of an integer, or empty.
 std::string format_integer(const std::optional<long>& value);
 /// The letter, or empty for '\0'.
 std::string format_letter(char c);
+/// The letter of a char-valued enum (Status, modes), or empty for '\0'.
+template <class Enum>
+std::string format_letter(Enum e) {
+  return format_letter(static_cast<char>(e));
+}
 
 }  // namespace usvfdi::nmea::fields
 

@@ -10,13 +10,6 @@ namespace {
 using fields::format_letter;
 using fields::format_number;
 
-Sentence make(const std::string& talker, const char* formatter) {
-  Sentence s;
-  s.talker = talker;
-  s.formatter = formatter;
-  return s;
-}
-
 std::optional<Rejection> status(const Sentence& s, std::size_t i, const char* what, Status* out) {
   char c = '\0';
   if (auto bad = fields::letter(s, i, what, "AV", &c)) return bad;
@@ -149,53 +142,49 @@ Result<Vtg> parse_vtg(const Sentence& s) {
 }
 
 Sentence to_sentence(const Rot& x) {
-  Sentence s = make(x.talker, "ROT");
-  s.fields = {format_number(x.rate_deg_per_min), format_letter(static_cast<char>(x.status))};
+  Sentence s = fields::make_sentence(x.talker, "ROT");
+  s.fields = {format_number(x.rate_deg_per_min), format_letter(x.status)};
   return s;
 }
 
 Sentence to_sentence(const Rsa& x) {
-  Sentence s = make(x.talker, "RSA");
-  s.fields = {format_number(x.starboard_deg), format_letter(static_cast<char>(x.starboard_status)),
-              format_number(x.port_deg), format_letter(static_cast<char>(x.port_status))};
+  Sentence s = fields::make_sentence(x.talker, "RSA");
+  s.fields = {format_number(x.starboard_deg), format_letter(x.starboard_status),
+              format_number(x.port_deg), format_letter(x.port_status)};
   return s;
 }
 
 Sentence to_sentence(const Hdt& x) {
-  Sentence s = make(x.talker, "HDT");
+  Sentence s = fields::make_sentence(x.talker, "HDT");
   s.fields = {format_number(x.heading_deg), "T"};
   return s;
 }
 
 Sentence to_sentence(const Ths& x) {
-  Sentence s = make(x.talker, "THS");
-  s.fields = {format_number(x.heading_deg), format_letter(static_cast<char>(x.mode))};
+  Sentence s = fields::make_sentence(x.talker, "THS");
+  s.fields = {format_number(x.heading_deg), format_letter(x.mode)};
   return s;
 }
 
 Sentence to_sentence(const Vbw& x) {
-  Sentence s = make(x.talker, "VBW");
-  s.fields = {format_number(x.water_longitudinal_kn),
-              format_number(x.water_transverse_kn),
-              format_letter(static_cast<char>(x.water_status)),
-              format_number(x.ground_longitudinal_kn),
-              format_number(x.ground_transverse_kn),
-              format_letter(static_cast<char>(x.ground_status))};
+  Sentence s = fields::make_sentence(x.talker, "VBW");
+  s.fields = {format_number(x.water_longitudinal_kn), format_number(x.water_transverse_kn),
+              format_letter(x.water_status),          format_number(x.ground_longitudinal_kn),
+              format_number(x.ground_transverse_kn),  format_letter(x.ground_status)};
   if (x.has_stern()) {
     s.fields.push_back(format_number(x.stern_water_transverse_kn));
-    s.fields.push_back(format_letter(static_cast<char>(x.stern_water_status)));
+    s.fields.push_back(format_letter(x.stern_water_status));
     s.fields.push_back(format_number(x.stern_ground_transverse_kn));
-    s.fields.push_back(format_letter(static_cast<char>(x.stern_ground_status)));
+    s.fields.push_back(format_letter(x.stern_ground_status));
   }
   return s;
 }
 
 Sentence to_sentence(const Vtg& x) {
-  Sentence s = make(x.talker, "VTG");
+  Sentence s = fields::make_sentence(x.talker, "VTG");
   s.fields = {format_number(x.course_true_deg), "T", format_number(x.course_magnetic_deg), "M",
               format_number(x.speed_kn),        "N", format_number(x.speed_kmh),           "K"};
-  if (x.mode != PositioningMode::kAbsent)
-    s.fields.push_back(format_letter(static_cast<char>(x.mode)));
+  if (x.mode != PositioningMode::kAbsent) s.fields.push_back(format_letter(x.mode));
   return s;
 }
 

@@ -1,28 +1,16 @@
 // Bridge alert management sentences: ALF, ALC, HBT, ARC, ACN (include/usv_fdi/nmea/alert.hpp).
 #include <gtest/gtest.h>
 
-#include <cstdio>
 #include <string>
 
+#include "support.hpp"
 #include "usv_fdi/nmea/alert.hpp"
 
 namespace usvfdi::nmea {
 namespace {
 
-Sentence sentence(const std::string& body) {
-  char b[3];
-  std::snprintf(b, sizeof b, "%02X", checksum(body));
-  auto r = parse_sentence("$" + body + "*" + b);
-  EXPECT_TRUE(r.ok()) << body << ": " << r.rejection().text;
-  return r.ok() ? r.value() : Sentence{};
-}
-
-template <class T, class Parse>
-Reason reason(Parse parse, const std::string& body) {
-  const Result<T> r = parse(sentence(body));
-  EXPECT_FALSE(r.ok()) << body;
-  return r.ok() ? Reason::kEmpty : r.rejection().reason;
-}
+using test::reason;
+using test::sentence;
 
 Alf gyro_alert() {
   Alf a;

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "support.hpp"
 #include "usv_fdi/nmea/datagram.hpp"
 
 namespace usvfdi::nmea {
@@ -36,10 +37,7 @@ TEST(Datagram, TagTimeInMillisecondsWhenElevenDigitsOrMore) {
   // wrong checksum first: refused
   ASSERT_FALSE(t.ok());
   EXPECT_EQ(t.rejection().reason, Reason::kBadTagBlock);
-  const std::string params = "c:1700000000123";
-  char b[3];
-  std::snprintf(b, sizeof b, "%02X", checksum(params));
-  auto ok = parse_tag_block(params + "*" + b);
+  auto ok = parse_tag_block(test::with_checksum("c:1700000000123").substr(1));
   ASSERT_TRUE(ok.ok()) << ok.rejection().text;
   EXPECT_EQ(ok.value().unix_time_ms, 1700000000123);
 }
@@ -131,9 +129,8 @@ TEST(Datagram, RejectsBadTagBlocks) {
   EXPECT_EQ(line_reason("\\s:GP0001\\$GPHDT,72.14,T*35"), Reason::kBadTagBlock);  // no checksum
   EXPECT_EQ(line_reason("\\s:GP0001*5\\$GPHDT,72.14,T*35"), Reason::kBadTagBlock);
   const auto with_sum = [](const std::string& params) {
-    char b[3];
-    std::snprintf(b, sizeof b, "%02X", checksum(params));
-    return "\\" + params + "*" + b + "\\$GPHDT,72.14,T*35";
+    // with_checksum's "$" replaced: the TAG block's checksum is the same XOR.
+    return "\\" + test::with_checksum(params).substr(1) + "\\$GPHDT,72.14,T*35";
   };
   EXPECT_TRUE(parse_tagged_sentence(with_sum("s:GP0001,x:whatever")).ok());  // unknown code
   EXPECT_EQ(line_reason(with_sum("s")), Reason::kBadTagBlock);

@@ -2,30 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
+#include "support.hpp"
 #include "usv_fdi/nmea/navigation.hpp"
 
 namespace usvfdi::nmea {
 namespace {
 
-/// The sentence of "$" + body + "*hh" (checksum by checksum(), checked against python3 in
-/// test_sentence.cpp), parsed; fails the test if the sentence layer refuses it.
-Sentence sentence(const std::string& body) {
-  char b[3];
-  std::snprintf(b, sizeof b, "%02X", checksum(body));
-  auto r = parse_sentence("$" + body + "*" + b);
-  EXPECT_TRUE(r.ok()) << body << ": " << r.rejection().text;
-  return r.ok() ? r.value() : Sentence{};
-}
-
-template <class T, class Parse>
-Reason reason(Parse parse, const std::string& body) {
-  const Result<T> r = parse(sentence(body));
-  EXPECT_FALSE(r.ok()) << body;
-  return r.ok() ? Reason::kEmpty : r.rejection().reason;
-}
+using test::reason;
+using test::sentence;
 
 TEST(Rot, ParsesSignAndStatus) {
   // python3: checksum of "HEROT,-12.4,A" is 0x31.

@@ -4,18 +4,13 @@
 #include <cstdio>
 #include <string>
 
+#include "support.hpp"
 #include "usv_fdi/nmea/sentence.hpp"
 
 namespace usvfdi::nmea {
 namespace {
 
-/// start + body + "*hh" with the checksum computed by checksum() (itself checked against
-/// python3-computed literals in ChecksumIsXorBetweenStartAndStar).
-std::string with_checksum(const std::string& body, char start = '$') {
-  char b[3];
-  std::snprintf(b, sizeof b, "%02X", checksum(body));
-  return start + body + "*" + b;
-}
+using test::with_checksum;
 
 Reason reason_of(std::string_view line) {
   const auto r = parse_sentence(line);
