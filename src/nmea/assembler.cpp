@@ -82,6 +82,27 @@ bool SampleAssembler::add(double t, const Vtg& vtg) {
   return true;
 }
 
+namespace {
+
+template <class T>
+InputResult feed(SampleAssembler* a, double t, const Result<T>& parsed) {
+  if (!parsed) return InputResult{InputUse::kRefused, parsed.rejection()};
+  if (!a->add(t, parsed.value())) return InputResult{InputUse::kOutOfOrder, {}};
+  return InputResult{InputUse::kUsed, {}};
+}
+
+}  // namespace
+
+InputResult SampleAssembler::add_sentence(double t, const Sentence& s) {
+  if (!s.proprietary) {
+    if (s.formatter == "ROT") return feed(this, t, parse_rot(s));
+    if (s.formatter == "RSA") return feed(this, t, parse_rsa(s));
+    if (s.formatter == "VBW") return feed(this, t, parse_vbw(s));
+    if (s.formatter == "VTG") return feed(this, t, parse_vtg(s));
+  }
+  return InputResult{InputUse::kNotAnInput, {}};
+}
+
 void SampleAssembler::advance(double t) {
   if (!started_ || !std::isfinite(t)) return;
   emit_before(t, true);

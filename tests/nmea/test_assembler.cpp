@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "support.hpp"
 #include "usv_fdi/nmea/assembler.hpp"
 
 namespace usvfdi::nmea {
@@ -210,6 +211,31 @@ TEST(Assembler, NoFloodAfterALongSilence) {
   EXPECT_LE(s.size(), 52u + 1u);  // one second of held values, then the new one
   EXPECT_NEAR(s.back().r, yaw_rate_from_rot(2.0), 1e-15);
   EXPECT_NEAR(s.back().t, 1.7e9 + 3600.0, 1e-6);
+}
+
+TEST(Assembler, AddSentenceDispatchesAndReports) {
+  SampleAssembler a(AssemblerConfig{});
+  const auto used = a.add_sentence(0.0, parse_sentence("$HEROT,-12.4,A*31").value());
+  EXPECT_EQ(used.use, InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("AGRSA,5.2,A,,V")).use, InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("IIVBW,7.5,-0.3,A,7.6,-0.2,A")).use,
+            InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("GPVTG,70.5,T,,M,10.2,N,18.9,K,A")).use,
+            InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, parse_sentence("$GPHDT,72.14,T*35").value()).use,
+            InputUse::kNotAnInput);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("PROT,1,A")).use, InputUse::kNotAnInput);
+  const auto refused = a.add_sentence(0.0, test::sentence("HEROT,20000,A"));
+  EXPECT_EQ(refused.use, InputUse::kRefused);
+  EXPECT_EQ(refused.rejection.reason, Reason::kOutOfRange);
+  EXPECT_EQ(a.add_sentence(-1.0, test::sentence("HEROT,1,A")).use, InputUse::kOutOfOrder);
+  a.advance(0.0);
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_NEAR(s[0].r, yaw_rate_from_rot(-12.4), 1e-15);  // the refused 20000 changed nothing
+  EXPECT_NEAR(s[0].delta, delta_from_rsa(5.2, RudderSign::kPositiveToPort), 1e-15);
+  EXPECT_NEAR(s[0].v, speed_from_knots(-0.3), 1e-15);
+  EXPECT_NEAR(s[0].u, speed_from_knots(7.5), 1e-15);
 }
 
 TEST(Assembler, RefusesBadConfiguration) {

@@ -56,6 +56,19 @@ struct AssembledSample {
   double age_u = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// What SampleAssembler::add_sentence did with a sentence.
+enum class InputUse {
+  kUsed,        ///< ROT, RSA, VBW or VTG, read and held
+  kNotAnInput,  ///< another sentence formatter (HDT, THS, ALF, ...): nothing to do
+  kRefused,     ///< its typed parser refused it (see the rejection)
+  kOutOfOrder,  ///< its time is not finite or earlier than the latest input's
+};
+
+struct InputResult {
+  InputUse use = InputUse::kUsed;
+  Rejection rejection;  ///< for kRefused
+};
+
 /// A quantity whose sentence has stopped.
 struct StaleInput {
   std::string quantity;  ///< "v", "r", "delta", "u"
@@ -76,6 +89,9 @@ class SampleAssembler {
   bool add(double t, const Rsa& rsa);
   bool add(double t, const Vbw& vbw);
   bool add(double t, const Vtg& vtg);
+
+  /// Parses a sentence of any formatter and adds it when it is one of the inputs.
+  InputResult add_sentence(double t, const Sentence& s);
 
   /// Emits the samples of every grid time <= t (time passing without input).
   void advance(double t);
