@@ -357,7 +357,7 @@ Result<std::vector<std::string>> format_alc_list(const std::string& talker, int 
   for (const auto& e : entries) {
     Alc trial = parts.back();
     trial.entries.push_back(e);
-    trial.total_sentences = trial.sentence_number = 99;
+    trial.total_sentences = trial.sentence_number = trial.message_id = 99;  // widest
     auto fits = format_alc(trial);
     if (!fits && fits.rejection().reason != Reason::kTooLong) return fits.rejection();
     if (!fits && parts.back().entries.empty()) return fits.rejection();

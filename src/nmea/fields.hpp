@@ -57,8 +57,9 @@ std::string format_letter(Enum e) {
 
 namespace usvfdi::nmea::fields {
 
-/// to_sentence(x), formatted, and refused where `parse` refuses the sentence (so a formatter
-/// never writes what its parser would reject).
+/// to_sentence(x), formatted, and refused where `parse` refuses the sentence or reads another
+/// value from it (a field that does not fit its text, e.g. an hour of 123): a formatter never
+/// writes what its parser would reject or read differently.
 template <class T, class Parse>
 Result<std::string> format_checked(const T& x, Parse parse) {
   const Sentence s = to_sentence(x);
@@ -66,6 +67,10 @@ Result<std::string> format_checked(const T& x, Parse parse) {
   if (!text) return text.rejection();
   const auto back = parse(s);
   if (!back) return back.rejection();
+  if (!(back.value() == x)) {
+    return reject(Reason::kOutOfRange, s.formatter + ": a value does not fit its field: " +
+                                           text.value().substr(0, text.value().size() - 2));
+  }
   return text;
 }
 

@@ -165,6 +165,12 @@ TEST(Alf, FormatterRefusesInvalidValues) {
   a = gyro_alert();
   a.state.reset();
   EXPECT_EQ(format_alf(a).rejection().reason, Reason::kBadField);
+  a = gyro_alert();
+  a.time = UtcTime{123, 0, 0};  // would be written "23": refused, not wrapped
+  EXPECT_EQ(format_alf(a).rejection().reason, Reason::kOutOfRange);
+  a = gyro_alert();
+  a.time = UtcTime{8, 15, -1};
+  EXPECT_FALSE(format_alf(a).ok());
 }
 
 TEST(Alc, FormatsAndParsesBack) {
@@ -205,6 +211,20 @@ TEST(Alc, ListSplitsIntoSentencesWithoutSplittingEntries) {
   ASSERT_EQ(none.value().size(), 1u);
   EXPECT_NE(none.value()[0].find(",1,1,1,0*"), std::string::npos) << none.value()[0];
   EXPECT_FALSE(format_alc_list("II", 100, entries).ok());
+  // Three of these entries fill a sentence to 82 characters with the head "1,1,0", to 83 with
+  // "10,10,99": the packing must measure the widest head (the message id's too), or the
+  // tenth sentence of message 99 would be refused.
+  std::vector<AlcEntry> tight;
+  for (int k = 0; k < 10; ++k) {
+    for (long instance : {1234L, 1234L, 12345L}) {
+      tight.push_back(AlcEntry{AlertIdentity{"FDI", 1234567, instance}, 99});
+    }
+  }
+  for (int id : {0, 9, 99}) {
+    const auto l = format_alc_list("II", id, tight);
+    ASSERT_TRUE(l.ok()) << id << ": " << l.rejection().text;
+    EXPECT_GE(l.value().size(), 10u);
+  }
 }
 
 TEST(Alc, Rejections) {
