@@ -344,6 +344,28 @@ Result<std::string> format_alf(const Alf& x) {
   return fields::format_checked(fitted, parse_alf);
 }
 
+Result<std::vector<std::string>> format_alf_message(const Alf& alert,
+                                                    const std::string& description) {
+  Alf title = alert;
+  title.total_sentences = description.empty() ? 1 : 2;
+  title.sentence_number = 1;
+  auto first = format_alf(title);
+  if (!first) return first.rejection();
+  std::vector<std::string> out{first.value()};
+  if (description.empty()) return out;
+  Alf second = title;
+  second.sentence_number = 2;
+  second.time.reset();
+  second.category.reset();
+  second.priority.reset();
+  second.state.reset();
+  second.text = description;
+  auto more = format_alf(second);
+  if (!more) return more.rejection();
+  out.push_back(more.value());
+  return out;
+}
+
 Result<std::string> format_alc(const Alc& x) { return fields::format_checked(x, parse_alc); }
 Result<std::string> format_hbt(const Hbt& x) { return fields::format_checked(x, parse_hbt); }
 Result<std::string> format_arc(const Arc& x) { return fields::format_checked(x, parse_arc); }

@@ -75,6 +75,35 @@ TEST(Alf, TextTruncatedToFitAndEscaped) {
   EXPECT_EQ(parsed.value().text, std::string(parsed.value().text.size(), ','));
 }
 
+TEST(Alf, MessageOfTitleAndDescription) {
+  Alf a = gyro_alert();
+  a.total_sentences = 2;  // ignored: set from the description
+  auto one = format_alf_message(a, "");
+  ASSERT_TRUE(one.ok()) << one.rejection().text;
+  ASSERT_EQ(one.value().size(), 1u);
+  EXPECT_EQ(one.value()[0], "$IIALF,1,1,3,081502.5,B,W,V,FDI,3001,2,7,0,INS gyro fault*43\r\n");
+
+  auto two = format_alf_message(a, "Yaw rate biased; check the gyro then ack");
+  ASSERT_TRUE(two.ok()) << two.rejection().text;
+  ASSERT_EQ(two.value().size(), 2u);
+  const auto s1 = parse_alf(parse_sentence(two.value()[0]).value());
+  const auto s2 = parse_alf(parse_sentence(two.value()[1]).value());
+  ASSERT_TRUE(s1.ok() && s2.ok());
+  EXPECT_EQ(s1.value().total_sentences, 2);
+  EXPECT_EQ(s1.value().sentence_number, 1);
+  EXPECT_EQ(s1.value().text, "INS gyro fault");
+  EXPECT_EQ(s1.value().state, AlertState::kActiveUnacknowledged);
+  EXPECT_EQ(s2.value().sentence_number, 2);
+  EXPECT_FALSE(s2.value().time || s2.value().category || s2.value().priority || s2.value().state);
+  EXPECT_EQ(s2.value().alert, a.alert);
+  EXPECT_EQ(s2.value().revision, a.revision);
+  EXPECT_EQ(s2.value().message_id, a.message_id);
+  EXPECT_EQ(s2.value().text, "Yaw rate biased; check the gyro then ack");
+
+  a.revision = 0;
+  EXPECT_EQ(format_alf_message(a, "x").rejection().reason, Reason::kOutOfRange);
+}
+
 TEST(Alf, SecondSentenceMayOmitCategoryPriorityState) {
   auto r = parse_alf(sentence("IIALF,2,2,3,,,,,FDI,3001,2,7,0,Check the gyro"));
   ASSERT_TRUE(r.ok()) << r.rejection().text;

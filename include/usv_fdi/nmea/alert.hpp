@@ -181,6 +181,13 @@ Result<std::string> format_hbt(const Hbt& x);
 Result<std::string> format_arc(const Arc& x);
 Result<std::string> format_acn(const Acn& x);
 
+/// An alert as ALF sentences: one (total 1) with `alert.text` as the title when `description`
+/// is empty; otherwise two (total 2), the title in sentence 1 and the description in sentence 2,
+/// whose time, category, priority and state are null. Each text is truncated to fit; the
+/// total and sentence number of `alert` are ignored.
+Result<std::vector<std::string>> format_alf_message(const Alf& alert,
+                                                    const std::string& description);
+
 /// The whole cyclic alert list as ALC sentences: as many entries per sentence as fit 82
 /// characters (none split), total and sentence numbers set; one sentence with 0 entries for
 /// an empty list.
