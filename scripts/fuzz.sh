@@ -3,7 +3,7 @@
 # each for a bounded time. Exits non-zero on the first crash, sanitizer report, leak, timeout or
 # out-of-memory; the reproducer is left in <build>/fuzz/artifacts/<target>/ and its path printed.
 #
-#   scripts/fuzz.sh [TARGET...]        TARGET: config, csv, engine (default: all three)
+#   scripts/fuzz.sh [TARGET...]        TARGET: config, csv, engine, nmea (default: all four)
 #   FUZZ_SECONDS=60   time per target (libFuzzer -max_total_time)
 #   FUZZ_JOBS=1       parallel fuzzing processes per target (-fork=N when > 1)
 #   FUZZ_ARGS=...     extra libFuzzer flags (e.g. -seed=1 -runs=100000)
@@ -20,11 +20,11 @@ seconds="${FUZZ_SECONDS:-60}"
 jobs="${FUZZ_JOBS:-1}"
 build_dir="${FUZZ_BUILD_DIR:-build-fuzz}"
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(config csv engine)
+[ ${#targets[@]} -gt 0 ] || targets=(config csv engine nmea)
 for t in "${targets[@]}"; do
   case "$t" in
-    config | csv | engine) ;;
-    *) echo "fuzz.sh: unknown target '$t' (expected config, csv or engine)" >&2; exit 2 ;;
+    config | csv | engine | nmea) ;;
+    *) echo "fuzz.sh: unknown target '$t' (expected config, csv, engine or nmea)" >&2; exit 2 ;;
   esac
 done
 case "$seconds" in

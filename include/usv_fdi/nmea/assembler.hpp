@@ -1,0 +1,132 @@
+// SampleAssembler: NMEA sentences arriving at their own rates -> samples on a fixed time base.
+//
+// Inputs (each with the time it was measured or received [s], e.g. a TAG block's c: or the
+// receive clock; times must not go backwards):
+//   ROT  -> r     [rad/s]  = ROT [deg/min] * pi / 10800 (same sign: > 0 bow to starboard)
+//   RSA  -> delta [rad]    = the starboard (single) rudder, or the port rudder when only that is
+//                            valid; sign by AssemblerConfig::rudder_sign (delta_from_rsa)
+//   VBW  -> v     [m/s]    = transverse WATER speed [kn] * 1852/3600 (same sign: > 0 to
+//                            starboard); needs the water status A
+//   VBW  -> u     [m/s]    = longitudinal water speed (speed through the water, what
+//                            core/speed.hpp wants), first choice
+//   VTG  -> u     [m/s]    = speed over ground, when no valid VBW water speed is fresh (a mode
+//                            indicator N, E, M or S makes it invalid)
+// A value whose status is V (or whose field is empty) invalidates the quantity from then on
+// without refreshing its age. Each quantity holds its latest valid value (zero-order hold).
+//
+// Output: a sample at every grid time g = k / rate_hz (k integer, so several assemblers share
+// the same grid), holding each quantity's latest valid value measured at or before g, and
+// NaN where that value is older than max_age_s, or none was received (NaN is how
+// usvfdi::Sample marks a missing value; u NaN = not measured). A grid time where every
+// quantity is missing is not emitted (no flood of empty samples after a long silence).
+// Samples are emitted when an input later than g arrives, or by advance(t) for g <= t.
+//
+// stale(t) names the sentences that have stopped: a quantity without a valid value for more
+// than max_age_s (or never received, max_age_s after the first input), with its age. (A
+// quantity invalidated by a status V within max_age_s is missing in the samples but not yet
+// stale: its sentence still arrives.)
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "usv_fdi/nmea/navigation.hpp"
+
+namespace usvfdi::nmea {
+
+struct AssemblerConfig {
+  double rate_hz = 10.0;   ///< output rate (> 0)
+  double max_age_s = 1.0;  ///< a value older than this is missing in the sample (> 0)
+  RudderSign rudder_sign = RudderSign::kPositiveToPort;  ///< the vessel model's (b2 < 0)
+};
+
+/// One output sample; NaN marks a missing value (as in usvfdi::Sample).
+struct AssembledSample {
+  double t = 0.0;                                           ///< grid time [s]
+  double v = std::numeric_limits<double>::quiet_NaN();      ///< sway velocity [m/s]
+  double r = std::numeric_limits<double>::quiet_NaN();      ///< yaw rate [rad/s]
+  double delta = std::numeric_limits<double>::quiet_NaN();  ///< rudder angle [rad]
+  double u = std::numeric_limits<double>::quiet_NaN();      ///< surge speed [m/s], optional
+  /// Age at t of the value used for v, r, delta, u [s] (NaN where missing).
+  double age_v = std::numeric_limits<double>::quiet_NaN();
+  double age_r = std::numeric_limits<double>::quiet_NaN();
+  double age_delta = std::numeric_limits<double>::quiet_NaN();
+  double age_u = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// What SampleAssembler::add_sentence did with a sentence.
+enum class InputUse {
+  kUsed,        ///< ROT, RSA, VBW or VTG, read and held
+  kNotAnInput,  ///< another sentence formatter (HDT, THS, ALF, ...): nothing to do
+  kRefused,     ///< its typed parser refused it (see the rejection)
+  kOutOfOrder,  ///< its time is not finite or earlier than the latest input's
+};
+
+struct InputResult {
+  InputUse use = InputUse::kUsed;
+  Rejection rejection;  ///< for kRefused
+};
+
+/// A quantity whose sentence has stopped.
+struct StaleInput {
+  std::string quantity;  ///< "v", "r", "delta", "u"
+  std::string sentence;  ///< the sentence that feeds it: "VBW", "ROT", "RSA", "VBW/VTG"
+  double age_s = 0.0;    ///< since its last valid value (or since the first input)
+  bool never_received = false;
+};
+
+class SampleAssembler {
+ public:
+  /// Refuses (std::invalid_argument) a rate or max age that is not finite and > 0: a
+  /// configuration error, the one exception of this library.
+  explicit SampleAssembler(const AssemblerConfig& config);
+
+  // Each returns false (and changes nothing) for a time that is not finite or earlier than the
+  // latest input's (counted in out_of_order()).
+  bool add(double t, const Rot& rot);
+  bool add(double t, const Rsa& rsa);
+  bool add(double t, const Vbw& vbw);
+  bool add(double t, const Vtg& vtg);
+
+  /// Parses a sentence of any formatter and adds it when it is one of the inputs.
+  InputResult add_sentence(double t, const Sentence& s);
+
+  /// Emits the samples of every grid time <= t (time passing without input).
+  void advance(double t);
+
+  /// The samples emitted since the last call, oldest first.
+  std::vector<AssembledSample> take();
+
+  /// The quantities without a valid value for more than max_age_s at time t.
+  std::vector<StaleInput> stale(double t) const;
+
+  std::size_t out_of_order() const { return out_of_order_; }
+
+ private:
+  struct Held {
+    double value = std::numeric_limits<double>::quiet_NaN();  ///< NaN: invalidated
+    double time = std::numeric_limits<double>::quiet_NaN();   ///< of the last valid value
+  };
+  enum Slot { kV = 0, kR, kDelta, kUWater, kUGround, kSlots };
+
+  bool accept_time(double t);
+  void emit_before(double t, bool inclusive);
+  long long first_grid_index(double t, bool after) const;
+  void set(Slot slot, double t, bool valid, double value);
+  /// The held value of `slot` at grid time g, or NaN (missing / too old); *age its age.
+  double at(Slot slot, double g, double* age) const;
+
+  AssemblerConfig config_;
+  double period_;
+  Held held_[kSlots];
+  double first_input_ = std::numeric_limits<double>::quiet_NaN();
+  double latest_input_ = -std::numeric_limits<double>::infinity();
+  long long next_k_ = 0;  ///< the next grid index to emit
+  bool started_ = false;
+  std::size_t out_of_order_ = 0;
+  std::vector<AssembledSample> out_;
+};
+
+}  // namespace usvfdi::nmea

@@ -1,0 +1,184 @@
+// SampleAssembler (include/usv_fdi/nmea/assembler.hpp).
+#include "usv_fdi/nmea/assembler.hpp"
+
+#include <climits>
+#include <cmath>
+#include <stdexcept>
+
+namespace usvfdi::nmea {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+SampleAssembler::SampleAssembler(const AssemblerConfig& config) : config_(config) {
+  if (!std::isfinite(config.rate_hz) || config.rate_hz <= 0.0) {
+    throw std::invalid_argument("SampleAssembler: rate_hz must be finite and > 0, not " +
+                                std::to_string(config.rate_hz));
+  }
+  if (!std::isfinite(config.max_age_s) || config.max_age_s <= 0.0) {
+    throw std::invalid_argument("SampleAssembler: max_age_s must be finite and > 0, not " +
+                                std::to_string(config.max_age_s));
+  }
+  period_ = 1.0 / config.rate_hz;
+}
+
+bool SampleAssembler::accept_time(double t) {
+  if (!std::isfinite(t) || t < latest_input_) {
+    ++out_of_order_;
+    return false;
+  }
+  if (!started_) {
+    started_ = true;
+    first_input_ = t;
+    next_k_ = first_grid_index(t, false);
+  }
+  emit_before(t, false);
+  latest_input_ = t;
+  return true;
+}
+
+void SampleAssembler::set(Slot slot, double t, bool valid, double value) {
+  if (valid && std::isfinite(value)) {
+    held_[slot].value = value;
+    held_[slot].time = t;
+  } else {
+    held_[slot].value = kNaN;  // invalid from now on; the age keeps counting
+  }
+}
+
+bool SampleAssembler::add(double t, const Rot& rot) {
+  if (!accept_time(t)) return false;
+  set(kR, t, rot.valid(), rot.valid() ? yaw_rate_from_rot(*rot.rate_deg_per_min) : kNaN);
+  return true;
+}
+
+bool SampleAssembler::add(double t, const Rsa& rsa) {
+  if (!accept_time(t)) return false;
+  if (rsa.starboard_valid()) {
+    set(kDelta, t, true, delta_from_rsa(*rsa.starboard_deg, config_.rudder_sign));
+  } else if (rsa.port_valid()) {
+    set(kDelta, t, true, delta_from_rsa(*rsa.port_deg, config_.rudder_sign));
+  } else {
+    set(kDelta, t, false, kNaN);
+  }
+  return true;
+}
+
+bool SampleAssembler::add(double t, const Vbw& vbw) {
+  if (!accept_time(t)) return false;
+  const bool water = vbw.water_valid();
+  set(kV, t, water && vbw.water_transverse_kn,
+      water && vbw.water_transverse_kn ? speed_from_knots(*vbw.water_transverse_kn) : kNaN);
+  set(kUWater, t, water && vbw.water_longitudinal_kn,
+      water && vbw.water_longitudinal_kn ? speed_from_knots(*vbw.water_longitudinal_kn) : kNaN);
+  return true;
+}
+
+bool SampleAssembler::add(double t, const Vtg& vtg) {
+  if (!accept_time(t)) return false;
+  const bool ok = vtg.valid() && vtg.speed_kn;
+  set(kUGround, t, ok, ok ? speed_from_knots(*vtg.speed_kn) : kNaN);
+  return true;
+}
+
+namespace {
+
+template <class T>
+InputResult feed(SampleAssembler* a, double t, const Result<T>& parsed) {
+  if (!parsed) return InputResult{InputUse::kRefused, parsed.rejection()};
+  if (!a->add(t, parsed.value())) return InputResult{InputUse::kOutOfOrder, {}};
+  return InputResult{InputUse::kUsed, {}};
+}
+
+}  // namespace
+
+InputResult SampleAssembler::add_sentence(double t, const Sentence& s) {
+  if (!s.proprietary) {
+    if (s.formatter == "ROT") return feed(this, t, parse_rot(s));
+    if (s.formatter == "RSA") return feed(this, t, parse_rsa(s));
+    if (s.formatter == "VBW") return feed(this, t, parse_vbw(s));
+    if (s.formatter == "VTG") return feed(this, t, parse_vtg(s));
+  }
+  return InputResult{InputUse::kNotAnInput, {}};
+}
+
+void SampleAssembler::advance(double t) {
+  if (!started_ || !std::isfinite(t)) return;
+  emit_before(t, true);
+}
+
+double SampleAssembler::at(Slot slot, double g, double* age) const {
+  const Held& h = held_[slot];
+  *age = kNaN;
+  if (std::isnan(h.value) || !(g - h.time <= config_.max_age_s)) return kNaN;
+  *age = g - h.time;
+  return h.value;
+}
+
+void SampleAssembler::emit_before(double t, bool inclusive) {
+  while (true) {
+    const double g = static_cast<double>(next_k_) * period_;
+    if (inclusive ? g > t : g >= t) return;
+    AssembledSample s;
+    s.t = g;
+    s.v = at(kV, g, &s.age_v);
+    s.r = at(kR, g, &s.age_r);
+    s.delta = at(kDelta, g, &s.age_delta);
+    s.u = at(kUWater, g, &s.age_u);
+    if (std::isnan(s.u)) s.u = at(kUGround, g, &s.age_u);
+    const bool any =
+        !std::isnan(s.v) || !std::isnan(s.r) || !std::isnan(s.delta) || !std::isnan(s.u);
+    if (!any) {
+      // Nothing held is fresh, and values only age until the next input at t: jump past t.
+      next_k_ = first_grid_index(t, inclusive);
+      return;
+    }
+    out_.push_back(s);
+    ++next_k_;
+  }
+}
+
+long long SampleAssembler::first_grid_index(double t, bool after) const {
+  // The first k with k * period > t (after) or >= t, robust to the rounding of t / period.
+  long long k = static_cast<long long>(std::ceil(t / period_));
+  const auto ok = [&](long long j) {
+    const double g = static_cast<double>(j) * period_;
+    return after ? g > t : g >= t;
+  };
+  while (k > LLONG_MIN && ok(k - 1)) --k;
+  while (!ok(k)) ++k;
+  return k;
+}
+
+std::vector<AssembledSample> SampleAssembler::take() {
+  std::vector<AssembledSample> out;
+  out.swap(out_);
+  return out;
+}
+
+std::vector<StaleInput> SampleAssembler::stale(double t) const {
+  std::vector<StaleInput> out;
+  if (!started_) return out;
+  const auto check = [&](const char* quantity, const char* sentence, double time) {
+    if (std::isnan(time)) {
+      if (t - first_input_ > config_.max_age_s) {
+        out.push_back(StaleInput{quantity, sentence, t - first_input_, true});
+      }
+    } else if (t - time > config_.max_age_s) {
+      out.push_back(StaleInput{quantity, sentence, t - time, false});
+    }
+  };
+  check("v", "VBW", held_[kV].time);
+  check("r", "ROT", held_[kR].time);
+  check("delta", "RSA", held_[kDelta].time);
+  const double u_water = held_[kUWater].time;
+  const double u_ground = held_[kUGround].time;
+  double u_time = kNaN;
+  if (!std::isnan(u_water)) u_time = u_water;
+  if (!std::isnan(u_ground) && (std::isnan(u_time) || u_ground > u_time)) u_time = u_ground;
+  check("u", "VBW/VTG", u_time);
+  return out;
+}
+
+}  // namespace usvfdi::nmea

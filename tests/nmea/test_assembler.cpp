@@ -1,0 +1,253 @@
+// SampleAssembler: sentences at their own rates -> samples on a fixed time base, in SI units and
+// the project's signs (include/usv_fdi/nmea/assembler.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "support.hpp"
+#include "usv_fdi/nmea/assembler.hpp"
+
+namespace usvfdi::nmea {
+namespace {
+
+constexpr double kDeg = kPi / 180.0;
+
+Rot rot(double deg_per_min, Status st = Status::kValid) {
+  Rot x;
+  x.rate_deg_per_min = deg_per_min;
+  x.status = st;
+  return x;
+}
+
+Rsa rsa(double deg, Status st = Status::kValid) {
+  Rsa x;
+  x.starboard_deg = deg;
+  x.starboard_status = st;
+  return x;
+}
+
+Vbw vbw(double longitudinal_kn, double transverse_kn, Status st = Status::kValid) {
+  Vbw x;
+  x.water_longitudinal_kn = longitudinal_kn;
+  x.water_transverse_kn = transverse_kn;
+  x.water_status = st;
+  return x;
+}
+
+Vtg vtg(double kn, PositioningMode mode = PositioningMode::kAutonomous) {
+  Vtg x;
+  x.speed_kn = kn;
+  x.mode = mode;
+  return x;
+}
+
+TEST(Assembler, UnitsAndSignsOfTheShippedVessels) {
+  SampleAssembler a(AssemblerConfig{});     // 10 Hz, 1 s, delta > 0 to port (b2 < 0)
+  ASSERT_TRUE(a.add(0.0, rot(60.0)));       // 60 deg/min, bow to starboard
+  ASSERT_TRUE(a.add(0.0, rsa(10.0)));       // rudder: bow turns to starboard
+  ASSERT_TRUE(a.add(0.0, vbw(5.0, -0.5)));  // 5 kn ahead, 0.5 kn to port
+  a.advance(0.0);
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_DOUBLE_EQ(s[0].t, 0.0);
+  EXPECT_NEAR(s[0].r, 1.0 * kDeg, 1e-15);              // r > 0: starboard
+  EXPECT_NEAR(s[0].delta, -10.0 * kDeg, 1e-15);        // RSA > 0 -> delta < 0 (delta > 0 = port)
+  EXPECT_NEAR(s[0].v, -0.5 * 1852.0 / 3600.0, 1e-15);  // v < 0: port
+  EXPECT_NEAR(s[0].u, 5.0 * 1852.0 / 3600.0, 1e-15);
+  EXPECT_DOUBLE_EQ(s[0].age_r, 0.0);
+
+  AssemblerConfig starboard;
+  starboard.rudder_sign = RudderSign::kPositiveToStarboard;  // container, kvlcc2
+  SampleAssembler b(starboard);
+  b.add(0.0, rsa(10.0));
+  b.advance(0.0);
+  EXPECT_NEAR(b.take().at(0).delta, 10.0 * kDeg, 1e-15);
+}
+
+TEST(Assembler, DifferentRatesOnOneGrid) {
+  SampleAssembler a(AssemblerConfig{});
+  // ROT at 20 Hz, RSA at 5 Hz, VBW at 1 Hz over 2 s, starting between grid times.
+  for (int i = 0; i <= 40; ++i) {
+    const double t = 100.01 + 0.05 * i;
+    a.add(t, rot(i));
+    if (i % 4 == 0) a.add(t, rsa(0.5 * i));
+    if (i % 20 == 0) a.add(t, vbw(4.0, 0.1 * i));
+  }
+  a.advance(102.05);
+  const auto s = a.take();
+  ASSERT_FALSE(s.empty());
+  EXPECT_NEAR(s.front().t, 100.1, 1e-9);  // the grid is k / rate
+  for (std::size_t k = 1; k < s.size(); ++k) EXPECT_NEAR(s[k].t - s[k - 1].t, 0.1, 1e-9);
+  EXPECT_NEAR(s.back().t, 102.0, 1e-9);
+  for (const auto& x : s) {
+    // The latest ROT at or before t: i = floor((t - 100.01) / 0.05).
+    const int i = static_cast<int>(std::floor((x.t - 100.01) / 0.05 + 1e-9));
+    EXPECT_NEAR(x.r, yaw_rate_from_rot(i), 1e-12) << x.t;
+    EXPECT_NEAR(x.age_r, x.t - (100.01 + 0.05 * i), 1e-9);
+    const int j = i - i % 4;
+    EXPECT_NEAR(x.delta, delta_from_rsa(0.5 * j, RudderSign::kPositiveToPort), 1e-12) << x.t;
+    EXPECT_FALSE(std::isnan(x.v)) << x.t;  // VBW at 1 Hz, held within max_age = 1 s
+    EXPECT_LE(x.age_v, 1.0);
+  }
+}
+
+TEST(Assembler, SampleUsesOnlyInputsAtOrBeforeItsTime) {
+  SampleAssembler a(AssemblerConfig{});
+  a.add(0.05, rot(1.0));
+  a.add(0.15, rot(2.0));  // emits 0.1 before applying this
+  a.add(0.2, rot(3.0));   // exactly on the grid: in the sample at 0.2
+  a.advance(0.2);
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_NEAR(s[0].r, yaw_rate_from_rot(1.0), 1e-15);
+  EXPECT_NEAR(s[1].r, yaw_rate_from_rot(3.0), 1e-15);
+}
+
+TEST(Assembler, OldValuesGoMissingAndTheSentenceIsReportedStale) {
+  AssemblerConfig c;
+  c.max_age_s = 0.5;
+  SampleAssembler a(c);
+  for (int i = 0; i <= 30; ++i) {
+    if (i <= 10) a.add(0.1 * i, rot(1.0));  // ROT until t = 1.0
+    a.add(0.1 * i, rsa(2.0));               // RSA until t = 3.0
+  }
+  EXPECT_EQ(a.out_of_order(), 0u);
+  a.advance(3.0);
+  for (const auto& x : a.take()) {
+    EXPECT_EQ(std::isnan(x.r), x.t > 1.5 + 1e-9) << x.t;
+    EXPECT_FALSE(std::isnan(x.delta)) << x.t;
+  }
+  const auto st = a.stale(3.0);
+  ASSERT_EQ(st.size(), 3u);  // r stopped; v and u never received
+  EXPECT_EQ(st[0].quantity, "v");
+  EXPECT_TRUE(st[0].never_received);
+  EXPECT_EQ(st[1].quantity, "r");
+  EXPECT_EQ(st[1].sentence, "ROT");
+  EXPECT_FALSE(st[1].never_received);
+  EXPECT_NEAR(st[1].age_s, 2.0, 1e-9);
+  EXPECT_EQ(st[2].sentence, "VBW/VTG");
+  EXPECT_TRUE(a.stale(1.4).size() == 2u);  // ROT not yet stale at 1.4
+}
+
+TEST(Assembler, StatusVInvalidatesWithoutRefreshingTheAge) {
+  SampleAssembler a(AssemblerConfig{});
+  a.add(0.0, rot(5.0));
+  a.add(0.25, rot(6.0, Status::kInvalid));
+  a.advance(0.3);
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 3u);  // 0.0, 0.1, 0.2 valid; 0.3 has nothing fresh: not emitted
+  EXPECT_FALSE(std::isnan(s[2].r));
+  a.add(0.5, rot(7.0));
+  a.advance(0.5);
+  const auto later = a.take();
+  ASSERT_EQ(later.size(), 1u);
+  EXPECT_NEAR(later[0].t, 0.5, 1e-12);
+  EXPECT_TRUE(a.stale(0.9).empty());  // ROT valid at 0.5; the others not yet max_age_s late
+  // An empty field is invalid as well.
+  Rot empty;
+  empty.status = Status::kValid;
+  a.add(0.6, empty);
+  a.advance(0.6);
+  EXPECT_TRUE(a.take().empty());
+  // Stale counts from the last VALID value (0.5), not from the invalid one (0.6).
+  ASSERT_FALSE(a.stale(1.55).empty());
+  bool r_stale = false;
+  for (const auto& x : a.stale(1.55))
+    r_stale = r_stale || (x.quantity == "r" && std::fabs(x.age_s - 1.05) < 1e-9);
+  EXPECT_TRUE(r_stale);
+}
+
+TEST(Assembler, SurgeFromVbwWaterElseVtg) {
+  SampleAssembler a(AssemblerConfig{});
+  a.add(0.0, vtg(10.0));
+  a.advance(0.0);
+  EXPECT_NEAR(a.take().at(0).u, speed_from_knots(10.0), 1e-12);  // VTG alone
+  a.add(0.1, vbw(8.0, 0.0));
+  a.add(0.1, vtg(10.0));
+  a.advance(0.1);
+  EXPECT_NEAR(a.take().at(0).u, speed_from_knots(8.0), 1e-12);  // VBW water first
+  a.add(0.2, vbw(8.0, 0.0, Status::kInvalid));
+  a.advance(0.2);
+  auto s = a.take().at(0);
+  EXPECT_NEAR(s.u, speed_from_knots(10.0), 1e-12);  // water invalid: VTG
+  EXPECT_TRUE(std::isnan(s.v));
+  a.add(0.3, vtg(10.0, PositioningMode::kNotValid));
+  a.advance(0.3);
+  EXPECT_TRUE(a.take().empty());  // nothing valid at 0.3
+}
+
+TEST(Assembler, PortRudderWhenOnlyItIsValid) {
+  SampleAssembler a(AssemblerConfig{});
+  Rsa twin;
+  twin.starboard_deg = 3.0;
+  twin.starboard_status = Status::kInvalid;
+  twin.port_deg = 4.0;
+  twin.port_status = Status::kValid;
+  a.add(0.0, twin);
+  a.advance(0.0);
+  EXPECT_NEAR(a.take().at(0).delta, -4.0 * kDeg, 1e-15);
+}
+
+TEST(Assembler, RefusesTimesThatGoBackOrAreNotFinite) {
+  SampleAssembler a(AssemblerConfig{});
+  EXPECT_TRUE(a.add(1.0, rot(1.0)));
+  EXPECT_FALSE(a.add(0.9, rot(2.0)));
+  EXPECT_FALSE(a.add(std::nan(""), rot(2.0)));
+  EXPECT_FALSE(a.add(HUGE_VAL, rot(2.0)));
+  EXPECT_EQ(a.out_of_order(), 3u);
+  a.advance(1.0);
+  EXPECT_NEAR(a.take().at(0).r, yaw_rate_from_rot(1.0), 1e-15);
+}
+
+TEST(Assembler, NoFloodAfterALongSilence) {
+  AssemblerConfig c;
+  c.rate_hz = 50.0;
+  SampleAssembler a(c);
+  a.add(1.7e9, rot(1.0));
+  a.add(1.7e9 + 3600.0, rot(2.0));
+  a.advance(1.7e9 + 3600.0);
+  const auto s = a.take();
+  EXPECT_LE(s.size(), 52u + 1u);  // one second of held values, then the new one
+  EXPECT_NEAR(s.back().r, yaw_rate_from_rot(2.0), 1e-15);
+  EXPECT_NEAR(s.back().t, 1.7e9 + 3600.0, 1e-6);
+}
+
+TEST(Assembler, AddSentenceDispatchesAndReports) {
+  SampleAssembler a(AssemblerConfig{});
+  const auto used = a.add_sentence(0.0, parse_sentence("$HEROT,-12.4,A*31").value());
+  EXPECT_EQ(used.use, InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("AGRSA,5.2,A,,V")).use, InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("IIVBW,7.5,-0.3,A,7.6,-0.2,A")).use,
+            InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("GPVTG,70.5,T,,M,10.2,N,18.9,K,A")).use,
+            InputUse::kUsed);
+  EXPECT_EQ(a.add_sentence(0.0, parse_sentence("$GPHDT,72.14,T*35").value()).use,
+            InputUse::kNotAnInput);
+  EXPECT_EQ(a.add_sentence(0.0, test::sentence("PROT,1,A")).use, InputUse::kNotAnInput);
+  const auto refused = a.add_sentence(0.0, test::sentence("HEROT,20000,A"));
+  EXPECT_EQ(refused.use, InputUse::kRefused);
+  EXPECT_EQ(refused.rejection.reason, Reason::kOutOfRange);
+  EXPECT_EQ(a.add_sentence(-1.0, test::sentence("HEROT,1,A")).use, InputUse::kOutOfOrder);
+  a.advance(0.0);
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_NEAR(s[0].r, yaw_rate_from_rot(-12.4), 1e-15);  // the refused 20000 changed nothing
+  EXPECT_NEAR(s[0].delta, delta_from_rsa(5.2, RudderSign::kPositiveToPort), 1e-15);
+  EXPECT_NEAR(s[0].v, speed_from_knots(-0.3), 1e-15);
+  EXPECT_NEAR(s[0].u, speed_from_knots(7.5), 1e-15);
+}
+
+TEST(Assembler, RefusesBadConfiguration) {
+  AssemblerConfig c;
+  c.rate_hz = 0.0;
+  EXPECT_THROW(SampleAssembler{c}, std::invalid_argument);
+  c.rate_hz = std::nan("");
+  EXPECT_THROW(SampleAssembler{c}, std::invalid_argument);
+  c = AssemblerConfig{};
+  c.max_age_s = -1.0;
+  EXPECT_THROW(SampleAssembler{c}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace usvfdi::nmea
