@@ -85,15 +85,17 @@ void Isolator::publish_bank() {
   if (!healthy_.empty()) {
     for (int c = 0; c < 2; ++c) {
       st_.thresholds(c) =
-          std::max(st_.thresholds(c), p_.history_margin * healthy_.extrapolated_max(c));
+          std::max(st_.thresholds(c), history_threshold(healthy_.extrapolated_max(c)));
       st_.thresholds_d(c) =
-          std::max(st_.thresholds_d(c), p_.history_margin * healthy_.extrapolated_max(2 + c));
+          std::max(st_.thresholds_d(c), history_threshold(healthy_.extrapolated_max(2 + c)));
     }
   }
   st_.threshold = act_.threshold.maxCoeff();
   st_.threshold_d = act_.threshold_d.maxCoeff();
   st_.relearning = has_shadow_;
 }
+
+double Isolator::reachable_threshold() const { return 0.75 * p_.clip * p_.clip; }
 
 double Isolator::learned_threshold(std::vector<double>* healthy) const {
   const double med = median_in_place(healthy);
@@ -102,7 +104,18 @@ double Isolator::learned_threshold(std::vector<double>* healthy) const {
   const double q999 = healthy->empty() ? 0.0 : (*healthy)[healthy->size() * 999 / 1000];
   // A windowed mean of clipped squares cannot exceed clip^2: keep the threshold reachable.
   return std::min(std::max({p_.threshold, med + p_.threshold_k * sd, p_.threshold_margin * q999}),
-                  0.75 * p_.clip * p_.clip);
+                  reachable_threshold());
+}
+
+double Isolator::history_threshold(double healthy_max) const {
+  // history_margin x the healthy maximum, but a windowed mean of clipped squares saturates
+  // at clip^2: past reachable_threshold() the margin shrinks to kMinHistoryMargin, so that
+  // a fault that pegs the statistic is still seen (a bar above clip^2 made a channel blind:
+  // a gyro drift of 10 sigma in 10 s on the Otter was never raised, J at 16 against 16.1).
+  constexpr double kMinHistoryMargin = 1.05;
+  const double bar = p_.history_margin * healthy_max;
+  if (bar <= reachable_threshold()) return bar;
+  return std::max(reachable_threshold(), kMinHistoryMargin * healthy_max);
 }
 
 std::size_t Isolator::window_samples(double dt) const {

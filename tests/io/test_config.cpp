@@ -178,7 +178,7 @@ identification:
   cubic_correction: false
   instruments: regressor
   max_std_error: 0.2
-  precision: prediction
+  precision: coefficients
   max_prediction_error: 0.03
   guard: false
   guard_threshold: 50
@@ -233,7 +233,7 @@ service:
   EXPECT_FALSE(c.identification.cubic_correction);
   EXPECT_EQ(c.identification.instruments, Instruments::kRegressor);
   EXPECT_EQ(c.identification.max_std_error, 0.2);
-  EXPECT_EQ(c.identification.precision, Precision::kPrediction);
+  EXPECT_EQ(c.identification.precision, Precision::kCoefficients);
   EXPECT_EQ(c.identification.max_prediction_error, 0.03);
   EXPECT_EQ(c.isolation.stuck_probability, 1e-6);
   EXPECT_EQ(c.isolation.stuck_learn_time, 30.0);

@@ -59,6 +59,16 @@ Outcome replay(const std::vector<Sample>& samples) {
   return out;
 }
 
+/// The raises, for a failure's message.
+std::string listed(const Outcome& o) {
+  std::string s = "raises:";
+  for (const FaultEvent& e : o.raises) {
+    s += std::string(" ") + to_string(e.sensor) + "/" + to_string(e.kind) + "@" +
+         std::to_string(e.t);
+  }
+  return s;
+}
+
 bool raised(const Outcome& o, Sensor sensor, double from, double to) {
   for (const FaultEvent& e : o.raises) {
     if (e.sensor == sensor && e.t >= from && e.t <= to) return true;
@@ -78,8 +88,8 @@ TEST(SourceClock, OneStampFarAheadIsRejectedAloneAndLaterFaultsAreRaised) {
   // THEN that sample alone is rejected, the time base stays, and both faults are raised
   EXPECT_EQ(o.rejected, 1u);
   EXPECT_EQ(o.resyncs, 0u);
-  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0));
-  EXPECT_TRUE(raised(o, Sensor::kGyro, 165.0, 177.0));
+  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0)) << listed(o);
+  EXPECT_TRUE(raised(o, Sensor::kGyro, 165.0, 177.0)) << listed(o);
 }
 
 TEST(SourceClock, AnInsClockRestartingAtZeroIsAdoptedAndTheNextVoyagesFaultsAreRaised) {
@@ -93,8 +103,8 @@ TEST(SourceClock, AnInsClockRestartingAtZeroIsAdoptedAndTheNextVoyagesFaultsAreR
   // second voyage are raised (no fault anywhere else)
   EXPECT_EQ(o.resyncs, 1u);
   EXPECT_LE(o.rejected, 10u);
-  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0));
-  EXPECT_TRUE(raised(o, Sensor::kGyro, 165.0, 177.0));
+  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0)) << listed(o);
+  EXPECT_TRUE(raised(o, Sensor::kGyro, 165.0, 177.0)) << listed(o);
   for (const FaultEvent& e : o.raises) {
     EXPECT_TRUE(e.sensor != Sensor::kUnknown || e.kind == FaultKind::kInvalid)
         << to_string(e.sensor) << " " << to_string(e.kind) << " at " << e.t;
@@ -120,7 +130,7 @@ TEST(SourceClock, SamplesDeliveredTwiceAreDroppedAndCountedNotTakenForTimingErro
   // voyage's own faults are raised (no timing fault on "unknown")
   EXPECT_EQ(o.duplicates, twice);
   EXPECT_EQ(o.rejected, 0u);
-  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0));
+  EXPECT_TRUE(raised(o, Sensor::kAccelerometer, 150.0, 160.0)) << listed(o);
   for (const FaultEvent& e : o.raises) {
     EXPECT_NE(e.sensor, Sensor::kUnknown) << to_string(e.kind) << " at " << e.t;
   }

@@ -113,10 +113,11 @@ struct IdentificationParams {
   /// Precision::kPrediction: the relative RMS error of the model's prediction that the
   /// standard errors allow (upper 90 % bound; Estimate::uncertainty) must be below this.
   double max_prediction_error = 0.02;
-  /// What max_std_error and settle_tolerance are relative to (docs/benchmark.md compares the
-  /// two: prediction arms on far more hulls, and so shows the isolation stage's false alarms
-  /// on nonlinear hulls in manoeuvres that coefficients hides by not arming).
-  Precision precision = Precision::kCoefficients;
+  /// What max_std_error and settle_tolerance are relative to. Prediction (the default since
+  /// 2026-12-03): what the remaining uncertainty does to the residuals, so the tiny a_n of a
+  /// slow ship need not be precise; on the proving ground it arms twice as many calm voyages
+  /// as coefficients, in half the time, at the same false-alarm rate (docs/benchmark.md).
+  Precision precision = Precision::kPrediction;
   // Consistency guard (Kreisselmeier only; see the header comment).
   bool guard = true;  ///< judge every window of data before it enters the memory
   /// A window is inconsistent when its equation-error statistic (chi-square with 4 degrees

@@ -345,6 +345,10 @@ class Isolator {
   FaultKind classify(int ch) const;
   std::size_t window_samples(double dt) const;
   double learned_threshold(std::vector<double>* healthy) const;
+  /// The highest threshold a windowed statistic of clipped squares reaches with margin.
+  double reachable_threshold() const;
+  /// The bar the healthy past sets for a statistic whose healthy maximum is healthy_max.
+  double history_threshold(double healthy_max) const;
 
   IsolationParams p_;
   Vec2 B_;
