@@ -16,6 +16,8 @@
 //   replay/csv_...                    io::replay (reader, plausibility check, FdiEngine::process
 //                                     per row, config/vessels/otter.yaml), its JSON Lines
 //                                     output written to /dev/null
+//   replay_engine_part/csv_...        FdiEngine::process alone on the same rows, read into
+//                                     memory beforehand (the replay's cost besides reading)
 //
 // Counter x_minimal: the benchmark's CPU time per row over the median of the minimal parse's
 // repetitions in the same run (the summary at the end gives the same ratio of medians).
@@ -39,6 +41,7 @@
 #include <unistd.h>
 
 #include "support/csv_reference.hpp"
+#include "usv_fdi/core/engine.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/config.hpp"
@@ -210,6 +213,25 @@ void bm_replay(benchmark::State& state) {
   });
 }
 
+/// The engine's part of the replay: the same rows, read beforehand (untimed), through a fresh
+/// FdiEngine per pass.
+void bm_engine_part(benchmark::State& state) {
+  const EngineConfig cfg =
+      io::load_engine_config(std::string(USV_FDI_SOURCE_DIR) + "/config/vessels/otter.yaml");
+  std::vector<Sample> samples;
+  io::CsvSampleReader reader(csv_file().path);
+  for (Sample s; reader.next(&s);) samples.push_back(s);
+  std::vector<FaultEvent> events;
+  run_passes(state, false, [&](const CsvFile&) {
+    FdiEngine engine(cfg);
+    for (const Sample& s : samples) {
+      events.clear();
+      benchmark::DoNotOptimize(engine.process(s, &events));
+    }
+    return samples.size();
+  });
+}
+
 }  // namespace
 
 void register_csv() {
@@ -219,6 +241,7 @@ void register_csv() {
   benchmark::RegisterBenchmark(("csv_reader/" + set).c_str(), bm_reader);
   benchmark::RegisterBenchmark(("csv_reader_before/" + set).c_str(), bm_reader_before);
   benchmark::RegisterBenchmark(("replay/" + set).c_str(), bm_replay);
+  benchmark::RegisterBenchmark(("replay_engine_part/" + set).c_str(), bm_engine_part);
 }
 
 }  // namespace usvfdi::bench
