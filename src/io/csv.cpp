@@ -143,8 +143,9 @@ bool CsvSampleReader::fill() {
 }
 
 bool CsvSampleReader::next_line(std::string_view* text) {
-  // A line is refused once kCsvMaxLine + 1 bytes of it are seen (+ 2 tell "no line end in
-  // sight" from "one byte too long"), so that a file without line ends cannot take the memory.
+  // At most kLook bytes of a line are looked at, so that a file without line ends cannot take
+  // the memory: kCsvMaxLine + 1 is "one byte too long", kCsvMaxLine + 2 "no line end in sight"
+  // (the two messages of the getline reader before).
   constexpr std::size_t kLook = kCsvMaxLine + 2;
   while (true) {
     std::size_t avail = end_ - begin_;
