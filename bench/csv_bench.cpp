@@ -1,7 +1,7 @@
 // Replay input cost: the CSV reader and the whole replay against a minimal parse of the same
 // file, side by side in one run (issue 14, item 6: replay within 1.5x of the minimal parse).
 //
-// The file: the paper's scenario on the Otter at 50 Hz stretched to one hour (180 000 rows),
+// The file: the paper's scenario on the Otter at 50 Hz stretched to one hour (180 001 rows),
 // written once by io::SimCsvWriter exactly as `usv-fdi sim` writes it (11 columns, %.17g) to a
 // temporary file, removed at exit. It stays in the page cache: "disk speed" here is the speed
 // of reading a cached file. One iteration is one row; a batch is one pass over the whole file
