@@ -3,11 +3,14 @@
 // Input: the header names the columns; t, v, r and delta are required in any order, u (the
 // surge speed through the water [m/s], core/speed.hpp) is read when present, other columns
 // are ignored. A field `nan`, `NaN` or empty is a missing value (NaN). Numbers are
-// parsed with strtod (C locale) and trailing garbage is an error. Blank lines and lines
+// read as strtod (C locale) reads them, and trailing garbage is an error: in place by
+// std::from_chars when they are plain decimals, by strtod otherwise (a leading '+', hex
+// floats, inf, values out of range). The input is read in blocks and parsed where it lies, so
+// that a row costs no allocation. Blank lines and lines
 // starting with '#' are skipped; CRLF line ends and a UTF-8 byte order mark are accepted.
 // Refused with an InputError: a NUL byte (a binary or UTF-16 file), a carriage return inside
 // a line (CR-only line ends), a line longer than kCsvMaxLine bytes (read no further than
-// that) and a header of more than kCsvMaxColumns columns.
+// one block past that) and a header of more than kCsvMaxColumns columns.
 //
 // Output: simulator rows with %.17g, so that sim -> CSV -> replay reproduces every double
 // bit for bit (a replay of the CSV gives exactly the events of the in-memory run).
@@ -18,6 +21,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "usv_fdi/core/simulator.hpp"
@@ -75,17 +79,25 @@ class CsvSampleReader {
 
  private:
   void read_header();
-  bool next_line(std::string* text);
+  /// The next line that is neither blank nor a comment, as a view into buffer_ (valid until
+  /// the next call), without its line end and, on line 1, its byte order mark.
+  bool next_line(std::string_view* text);
+  /// Moves the unread bytes to the front of buffer_ and reads a block after them; false when
+  /// nothing more could be read.
+  bool fill();
 
   std::unique_ptr<std::istream> in_;
   std::string name_;
   std::size_t line_ = 0;
   std::size_t rows_ = 0;
   std::vector<std::string> header_;
-  int col_[4] = {-1, -1, -1, -1};  ///< field index of t, v, r, delta
-  int col_u_ = -1;                 ///< field index of the optional u
-  std::vector<std::string> fields_;
-  std::vector<char> buffer_;  ///< kCsvMaxLine + 1 bytes for one line
+  int col_[4] = {-1, -1, -1, -1};         ///< field index of t, v, r, delta
+  int col_u_ = -1;                        ///< field index of the optional u
+  std::vector<std::string_view> fields_;  ///< the current line's fields, views into buffer_
+  std::vector<char> buffer_;  ///< the longest line (kCsvMaxLine + 2 bytes) and a block more
+  std::size_t begin_ = 0;     ///< buffer_[begin_, end_): read from the input, not yet parsed
+  std::size_t end_ = 0;
+  bool eof_ = false;  ///< the input has no more bytes
 };
 
 /// Writes simulator rows: t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g
