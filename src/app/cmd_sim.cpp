@@ -21,6 +21,7 @@
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/csv.hpp"
+#include "usv_fdi/io/nmea_log.hpp"
 #include "usv_fdi/io/output_file.hpp"
 #include "usv_fdi/io/scenarios.hpp"
 #include "usv_fdi/sim/voyage.hpp"
@@ -41,8 +42,10 @@ struct SimArgs : VoyageCommon {
     vessel = "otter";
     scenario = "paper";
   }
-  std::string steering;  ///< empty: the scenario's
-  VoyageArgs voyage;     ///< options of the voyage scenarios (sim_voyage.cpp)
+  std::string steering;       ///< empty: the scenario's
+  bool nmea = false;          ///< write NMEA sentences instead of CSV rows
+  bool nmea_heading = false;  ///< --nmea: also $HEHDT
+  VoyageArgs voyage;          ///< options of the voyage scenarios (sim_voyage.cpp)
 #ifdef USV_FDI_APP_WITH_DDS
   bool publish = false;
   std::vector<std::uint32_t> mmsi;
@@ -95,6 +98,10 @@ int run_voyage_scenario(const SimArgs& a) {
 #endif
   if (a.output.empty()) {
     spdlog::error("sim: give --output FILE");
+    return kExitUsage;
+  }
+  if (a.nmea) {
+    spdlog::error("--nmea writes the classic scenarios (paper, healthy, faults) only");
     return kExitUsage;
   }
   return run_voyage_sim(a, a.voyage);
@@ -244,8 +251,8 @@ int publish_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig
 }
 #endif
 
-/// The classic scenario into the --output CSV (a temporary file renamed at the end).
-int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
+/// The classic scenario into the --output CSV or NMEA log (a temporary file renamed at the end).
+int write_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
   std::unique_ptr<Simulator> sim;
   try {
     sim = std::make_unique<Simulator>(c);
@@ -256,12 +263,31 @@ int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConf
   const bool to_stdout = a.output == "-";
   const std::unique_ptr<io::OutputFile> output = open_output(a.output);
   if (output == nullptr) return kExitOutput;
-  io::SimCsvWriter writer(output->stream());
+  std::optional<io::SimCsvWriter> csv;
+  std::optional<io::NmeaSimWriter> nmea;
+  if (a.nmea) {
+    io::NmeaOutputOptions o;
+    o.b2 = vessel.B(1);
+    o.surge_speed = vessel.u0;
+    o.heading = a.nmea_heading;
+    nmea.emplace(output->stream(), o);
+  } else {
+    csv.emplace(output->stream());
+  }
   SimRow row;
   std::size_t rows = 0;
-  while (sim->next(&row)) {
-    writer.write(row);
-    ++rows;
+  try {
+    while (sim->next(&row)) {
+      if (nmea) {
+        nmea->write(row);
+      } else {
+        csv->write(row);
+      }
+      ++rows;
+    }
+  } catch (const std::runtime_error& e) {  // a value no NMEA sentence can hold
+    spdlog::error("{}", e.what());
+    return kExitFailure;
   }
   try {
     output->commit();
@@ -270,11 +296,12 @@ int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConf
     return kExitOutput;
   }
   spdlog::info(
-      "{}: {} rows, vessel {}, scenario {}, {} Hz, {} s, seed {}, {} steering, noise "
+      "{}: {} {}, vessel {}, scenario {}, {} Hz, {} s, seed {}, {} steering, noise "
       "sigma_v {:.3g} m/s sigma_r {:.3g} rad/s",
-      to_stdout ? std::string("stdout") : a.output, rows, vessel.name, a.scenario, c.rate_hz,
-      c.duration, c.seed, c.steering == Steering::kSine ? "sine" : "autopilot", c.sigma_v,
-      c.sigma_r);
+      to_stdout ? std::string("stdout") : a.output, rows,
+      a.nmea ? "samples as NMEA (ROT, RSA, VBW with TAG times)" : "rows", vessel.name, a.scenario,
+      c.rate_hz, c.duration, c.seed, c.steering == Steering::kSine ? "sine" : "autopilot",
+      c.sigma_v, c.sigma_r);
   for (const FaultInjection& f : c.faults) spdlog::info("  fault {}", io::format_fault_spec(f));
   if (c.faults.empty()) spdlog::info("  no faults");
   return kExitOk;
@@ -305,7 +332,7 @@ int run_sim(const SimArgs& a) {
     return kExitUsage;
   }
 #endif
-  return write_classic_csv(a, vessel, c);
+  return write_classic(a, vessel, c);
 }
 
 /// --vessel, --scenario, --rate, --duration, --seed, --fault.
@@ -390,6 +417,12 @@ void register_sim_command(CommandRegistry& registry) {
                    [args] { return run_sim(*args); });
   add_scenario_options(sub, args.get());
   add_voyage_options(sub, &args->voyage);
+  sub->add_flag("--nmea", args->nmea,
+                "classic scenarios: write NMEA 0183 sentences instead of CSV: per sample "
+                "$HEROT (r, deg/min, 3 decimals), $AGRSA (delta, deg, 3 decimals, RSA sign: > 0 "
+                "bow to starboard), $VDVBW (v and the vessel's nominal u, kn, 4 decimals), each "
+                "after a TAG block with c: = 2026-01-01T00:00:00Z + t (ms)");
+  sub->add_flag("--nmea-heading", args->nmea_heading, "--nmea: also $HEHDT (psi, deg)");
   sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
       ->check(CLI::IsMember({"autopilot", "sine"}));
   sub->add_option("--noise-scale", args->noise_scale,
