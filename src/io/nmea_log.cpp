@@ -1,16 +1,16 @@
 #include "usv_fdi/io/nmea_log.hpp"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 #include <utility>
 
 #include "usv_fdi/io/csv.hpp"  // InputError
@@ -66,15 +66,12 @@ std::string NmeaLineStats::describe() const {
 
 NmeaSampleReader::NmeaSampleReader(const std::string& path, const NmeaInputOptions& options)
     : NmeaSampleReader(nullptr, path, options) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
-    throw InputError(path, 0, "", "", std::string("cannot read: ") + std::strerror(errno));
-  }
-  if (S_ISDIR(st.st_mode)) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
     throw InputError(path, 0, "", "", std::string("cannot read: ") + std::strerror(EISDIR));
   }
   auto f = std::make_unique<std::ifstream>(path, std::ios::binary);
-  if (!*f) {
+  if (!f->is_open()) {
     throw InputError(path, 0, "", "", std::string("cannot open: ") + std::strerror(errno));
   }
   in_ = std::move(f);
@@ -120,13 +117,7 @@ bool NmeaSampleReader::refill() {
       read_line(text);
     }
     for (const nmea::AssembledSample& a : assembler_->take()) {
-      Sample s;
-      s.t = a.t;
-      s.v = a.v;
-      s.r = a.r;
-      s.delta = a.delta;
-      s.u = a.u;
-      pending_.push_back(s);
+      pending_.push_back(Sample{a.t, a.v, a.r, a.delta, a.u});
     }
     if (eof_) break;
   }
@@ -202,38 +193,25 @@ void NmeaSampleReader::read_line(const std::string& raw) {
   bool valid = false;
   bool added = false;
   nmea::Rejection why;
+  const auto feed = [&](const auto& parsed, auto is_valid) {
+    if (!parsed) {
+      why = parsed.rejection();
+      return;
+    }
+    valid = is_valid(parsed.value());
+    added = assembler_->add(*t, parsed.value());
+  };
   if (f == "ROT") {
-    const auto x = nmea::parse_rot(s);
-    if (x) {
-      valid = x.value().valid();
-      added = assembler_->add(*t, x.value());
-    } else {
-      why = x.rejection();
-    }
+    feed(nmea::parse_rot(s), [](const nmea::Rot& x) { return x.valid(); });
   } else if (f == "RSA") {
-    const auto x = nmea::parse_rsa(s);
-    if (x) {
-      valid = x.value().starboard_valid() || x.value().port_valid();
-      added = assembler_->add(*t, x.value());
-    } else {
-      why = x.rejection();
-    }
+    feed(nmea::parse_rsa(s),
+         [](const nmea::Rsa& x) { return x.starboard_valid() || x.port_valid(); });
   } else if (f == "VBW") {
-    const auto x = nmea::parse_vbw(s);
-    if (x) {
-      valid = x.value().water_valid() && x.value().water_transverse_kn;
-      added = assembler_->add(*t, x.value());
-    } else {
-      why = x.rejection();
-    }
+    feed(nmea::parse_vbw(s),
+         [](const nmea::Vbw& x) { return x.water_valid() && x.water_transverse_kn.has_value(); });
   } else {
-    const auto x = nmea::parse_vtg(s);
-    if (x) {
-      valid = x.value().valid() && x.value().speed_kn;
-      added = assembler_->add(*t, x.value());
-    } else {
-      why = x.rejection();
-    }
+    feed(nmea::parse_vtg(s),
+         [](const nmea::Vtg& x) { return x.valid() && x.speed_kn.has_value(); });
   }
   if (!why.text.empty()) {
     count(nmea::to_string(why.reason), f + ": " + why.text);
