@@ -42,10 +42,8 @@ struct SimArgs : VoyageCommon {
     vessel = "otter";
     scenario = "paper";
   }
-  std::string steering;       ///< empty: the scenario's
-  bool nmea = false;          ///< write NMEA sentences instead of CSV rows
-  bool nmea_heading = false;  ///< --nmea: also $HEHDT
-  VoyageArgs voyage;          ///< options of the voyage scenarios (sim_voyage.cpp)
+  std::string steering;  ///< empty: the scenario's
+  VoyageArgs voyage;     ///< options of the voyage scenarios (sim_voyage.cpp)
 #ifdef USV_FDI_APP_WITH_DDS
   bool publish = false;
   std::vector<std::uint32_t> mmsi;
@@ -98,10 +96,6 @@ int run_voyage_scenario(const SimArgs& a) {
 #endif
   if (a.output.empty()) {
     spdlog::error("sim: give --output FILE");
-    return kExitUsage;
-  }
-  if (a.nmea) {
-    spdlog::error("--nmea writes the classic scenarios (paper, healthy, faults) only");
     return kExitUsage;
   }
   return run_voyage_sim(a, a.voyage);
@@ -418,7 +412,7 @@ void register_sim_command(CommandRegistry& registry) {
   add_scenario_options(sub, args.get());
   add_voyage_options(sub, &args->voyage);
   sub->add_flag("--nmea", args->nmea,
-                "classic scenarios: write NMEA 0183 sentences instead of CSV: per sample "
+                "write NMEA 0183 sentences instead of CSV: per sample "
                 "$HEROT (r, deg/min, 3 decimals), $AGRSA (delta, deg, 3 decimals, RSA sign: > 0 "
                 "bow to starboard), $VDVBW (v and the vessel's nominal u, kn, 4 decimals), each "
                 "after a TAG block with c: = 2026-01-01T00:00:00Z + t (ms)");

@@ -37,6 +37,8 @@ struct VoyageCommon {
   std::uint64_t seed = 1;
   double noise_scale = 1.0;
   std::vector<std::string> faults;  ///< channel units, as in the classic scenarios
+  bool nmea = false;                ///< write NMEA sentences instead of CSV rows
+  bool nmea_heading = false;        ///< --nmea: also $HEHDT
 };
 
 /// Every hull `--vessel` accepts with a voyage scenario.
@@ -44,7 +46,7 @@ std::vector<std::string> voyage_vessel_names();
 /// The hull of that name (the zoo's, else a shipped vessel as a linear hull); nullptr if none.
 std::shared_ptr<const sim::Hull> find_voyage_hull(const std::string& name);
 void add_voyage_options(CLI::App* sub, VoyageArgs* a);
-/// Runs the voyage and writes its CSV; returns the exit code.
+/// Runs the voyage and writes its CSV (or NMEA log); returns the exit code.
 int run_voyage_sim(const VoyageCommon& common, const VoyageArgs& a);
 
 }  // namespace usvfdi::app
