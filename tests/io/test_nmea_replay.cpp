@@ -23,10 +23,7 @@ namespace usvfdi::io {
 namespace {
 
 namespace js = usvfdi::testing_json;
-using testing_cli::kExe;
-using testing_cli::kSource;
-using testing_cli::Outcome;
-using testing_cli::slurp;
+namespace cli = usvfdi::testing_cli;
 
 /// A raised event of a replay: sensor and detection time [s since the voyage's start].
 struct Raised {
@@ -46,19 +43,19 @@ class NmeaReplay : public ::testing::Test {
     if (!HasFailure()) std::system(("rm -rf '" + dir_ + "'").c_str());
   }
   std::string path(const std::string& name) const { return dir_ + name; }
-  Outcome run(const std::string& args) const {
-    return testing_cli::run_shell("'" + kExe + "' " + args, dir_);
+  cli::Outcome run(const std::string& args) const {
+    return testing_cli::run_shell("'" + cli::kExe + "' " + args, dir_);
   }
   /// Replays `input` with `config` (relative to the repository) into the JSON records.
   std::vector<js::Value> replay(const std::string& config, const std::string& input,
                                 const std::string& extra = "", int expect_code = 0) const {
     const std::string out = path("out.jsonl");
-    const Outcome r = run("replay --config '" + kSource + "/" + config + "' --input '" + input +
-                          "' --output '" + out + "' " + extra);
+    const cli::Outcome r = run("replay --config '" + cli::kSource + "/" + config + "' --input '" +
+                               input + "' --output '" + out + "' " + extra);
     EXPECT_EQ(r.code, expect_code) << r.err;
     last_err_ = r.err;
     std::vector<js::Value> recs;
-    std::istringstream in(slurp(out));
+    std::istringstream in(cli::slurp(out));
     for (std::string line; std::getline(in, line);) recs.push_back(js::parse(line));
     return recs;
   }
@@ -97,9 +94,9 @@ TEST_F(NmeaReplay, PaperScenarioThroughNmeaRaisesAndIsolatesBothFaultsLikeTheCsv
   const std::string sim =
       "sim --vessel otter --scenario paper --rate 10 --noise-scale 0 --seed 1 --output '";
   ASSERT_EQ(run(sim + path("paper.csv") + "'").code, 0);
-  const Outcome s = run(sim + path("paper.nmea") + "' --nmea");
+  const cli::Outcome s = run(sim + path("paper.nmea") + "' --nmea");
   ASSERT_EQ(s.code, 0) << s.err;
-  const std::string log = slurp(path("paper.nmea"));
+  const std::string log = cli::slurp(path("paper.nmea"));
   EXPECT_EQ(log.rfind("\\s:HE0001,n:1,c:1767225600*", 0), 0u) << log.substr(0, 80);
   EXPECT_TRUE(has(log, "$HEROT,") && has(log, "$AGRSA,") && has(log, "$VDVBW,"));
 
@@ -129,12 +126,12 @@ TEST_F(NmeaReplay, PaperScenarioThroughNmeaRaisesAndIsolatesBothFaultsLikeTheCsv
 }
 
 TEST_F(NmeaReplay, HealthyVoyageThroughNmeaRaisesNothing) {
-  const Outcome s =
+  const cli::Outcome s =
       run("sim --vessel otter --scenario healthy --rate 10 --duration 150 --seed 1 --nmea "
           "--nmea-heading --output '" +
           path("healthy.nmea") + "'");
   ASSERT_EQ(s.code, 0) << s.err;
-  EXPECT_TRUE(has(slurp(path("healthy.nmea")), "$HEHDT,"));
+  EXPECT_TRUE(has(cli::slurp(path("healthy.nmea")), "$HEHDT,"));
   const auto recs = replay("config/vessels/otter.yaml", path("healthy.nmea"));
   EXPECT_TRUE(raised(recs).empty());
   EXPECT_EQ(recs.back().at("samples").num, 1501.0);
@@ -147,7 +144,7 @@ TEST_F(NmeaReplay, CorruptedLinesAreCountedByReasonAndNeverStopTheReplay) {
                 path("short.nmea") + "'")
                 .code,
             0);
-  std::istringstream in(slurp(path("short.nmea")));
+  std::istringstream in(cli::slurp(path("short.nmea")));
   std::vector<std::string> lines;
   for (std::string l; std::getline(in, l);) lines.push_back(l + "\n");
   ASSERT_EQ(lines.size(), 903u);  // 301 samples, 3 sentences each
@@ -210,6 +207,55 @@ TEST_F(NmeaReplay, FormatNmeaReadsALogOfAnyName) {
             0);
   const auto recs = replay("config/scenarios/paper.yaml", path("log.txt"), "--format nmea");
   EXPECT_EQ(recs.back().at("samples").num, 101.0);
+
+  // The same sentences as IEC 61162-450 datagrams, one a sample: "UdPbC", NUL, the TAG block
+  // and ROT; RSA and VBW on the next lines without a TAG block (they share the datagram's).
+  std::istringstream in(cli::slurp(path("log.txt")));
+  std::string datagrams;
+  std::size_t k = 0;
+  for (std::string l; std::getline(in, l); ++k) {
+    l.pop_back();  // the CR of the sim's CR LF
+    datagrams += k % 3 == 0 ? std::string("UdPbC", 5) + '\0' + l : l.substr(l.find('$'));
+    datagrams += "\r\n";
+  }
+  {
+    std::ofstream f(path("datagrams.nmea"), std::ios::binary);
+    f << datagrams;
+  }
+  const auto dg = replay("config/scenarios/paper.yaml", path("datagrams.nmea"));
+  EXPECT_EQ(dg.back().at("samples").num, 101.0);
+  EXPECT_EQ(dg.back().at("final_a").arr.at(0).num, recs.back().at("final_a").arr.at(0).num);
+  EXPECT_TRUE(has(last_err_, "303 used")) << last_err_;
+}
+
+TEST_F(NmeaReplay, StarboardTurnOfAVoyageIsPositiveRotAndRsa) {
+  // The voyage `turn` on the Otter: hold course, then a turning circle to starboard (the
+  // default --side) with the rudder hard over from about 20 s to 55 s.
+  const cli::Outcome s =
+      run("sim --vessel otter --scenario turn --rate 10 --duration 60 --nmea "
+          "--output '" +
+          path("turn.nmea") + "'");
+  ASSERT_EQ(s.code, 0) << s.err;
+  std::istringstream in(cli::slurp(path("turn.nmea")));
+  std::size_t k = 0, rot = 0, rsa = 0;
+  for (std::string l; std::getline(in, l); ++k) {
+    const std::string x = l.substr(l.find('$'));
+    if (k < 3 * 300 || k >= 3 * 500) continue;  // t in [30, 50) s: in the turn
+    if (x.rfind("$HEROT,", 0) == 0) {
+      EXPECT_GT(std::stod(x.substr(7)), 0.0) << x;  // bow to starboard: r > 0
+      ++rot;
+    } else if (x.rfind("$AGRSA,", 0) == 0) {
+      EXPECT_GT(std::stod(x.substr(7)), 0.0) << x;  // RSA > 0: turns the bow to starboard
+      ++rsa;
+    }
+  }
+  EXPECT_EQ(rot, 200u);
+  EXPECT_EQ(rsa, 200u);
+  // The replay reads it back with the Otter's B (b2 < 0: delta < 0 in the turn), raising
+  // nothing on the saturated rudder or the quantised sentences.
+  const auto recs = replay("config/vessels/otter.yaml", path("turn.nmea"));
+  EXPECT_TRUE(raised(recs).empty());
+  EXPECT_TRUE(has(last_err_, "0 unusable")) << last_err_;
 }
 
 // Signs: the simulator's samples written as sentences and read back agree within the
