@@ -403,12 +403,12 @@ void add_publish_options(CLI::App* sub, SimArgs* args) {
 
 void register_sim_command(CommandRegistry& registry) {
   auto args = std::make_shared<SimArgs>();
-  CLI::App* sub =
-      registry.add("sim",
-                   "Simulate a vessel with optional INS faults and write CSV rows "
-                   "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
-                   "scenarios add u and more; %.17g)",
-                   [args] { return run_sim(*args); });
+  CLI::App* sub = registry.add(
+      "sim",
+      "Simulate a vessel with optional INS faults and write CSV rows "
+      "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
+      "scenarios add u and more; %.17g), or with --nmea NMEA 0183 sentences with TAG times",
+      [args] { return run_sim(*args); });
   add_scenario_options(sub, args.get());
   add_voyage_options(sub, &args->voyage);
   sub->add_flag("--nmea", args->nmea,

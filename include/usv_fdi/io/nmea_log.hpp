@@ -19,16 +19,18 @@
 //
 // Unusable lines never stop the replay: each is counted under its reason (checksum mismatch,
 // malformed, out of range, status V, no time, time going back, ...) with its first line. Lines
-// of other sentence formatters (HDT, THS, GGA, ...) and unknown talkers are ignored, not
-// unusable.
+// of other sentence formatters (HDT, THS, GGA, proprietary, ...) are ignored, not unusable; any
+// talker is accepted.
 //
 // Output (sim --nmea): per simulator row a TAG block with c: (epoch + t, in milliseconds) and
 // n: (line count), then $HEROT (r), $AGRSA (delta, sign by B), $VDVBW (v; u), optionally
-// $HEHDT (psi). Talkers: HE heading sensor, north-seeking gyro (ROT, HDT); AG autopilot,
-// general (RSA); VD velocity sensor, Doppler (VBW): the nmea library's defaults. Rounding:
-// ROT 3 decimals [deg/min], RSA 3 decimals [deg], VBW 4 decimals [kn], HDT 2 decimals [deg]
-// (kNmeaDecimals*), far below the vessels' sensor noise, so that the engine's stuck check does
-// not take the quantisation for a stuck sensor.
+// $HEHDT (psi). Talkers: HE heading, north-seeking gyro (ROT, HDT); AG autopilot, general
+// (RSA); VD velocity sensor, Doppler, other/general (VBW): the nmea library's defaults, as the
+// talker tables of open-source NMEA parsers found with the search tool name them (they also
+// list TI turn rate indicator and RI rudder angle indicator; a replay accepts any talker).
+// Rounding: ROT 3 decimals [deg/min], RSA 3 decimals [deg], VBW 4 decimals [kn], HDT 2 decimals
+// [deg] (kNmeaDecimals*), far below the vessels' sensor noise, so that the engine's stuck check
+// does not take the quantisation for a stuck sensor.
 #pragma once
 
 #include <cstddef>
@@ -54,7 +56,7 @@ constexpr int kNmeaDecimalsRot = 3;      ///< deg/min: 1e-3 deg/min = 2.9e-7 rad
 constexpr int kNmeaDecimalsRudder = 3;   ///< deg: 1e-3 deg = 1.7e-5 rad
 constexpr int kNmeaDecimalsSpeed = 4;    ///< kn: 1e-4 kn = 5.1e-5 m/s
 constexpr int kNmeaDecimalsHeading = 2;  ///< deg
-/// Longest line read [bytes]; a longer one is counted as too long (and read no further).
+/// Longest line used [bytes]; a longer one is counted as too long.
 constexpr std::size_t kNmeaMaxLine = 4096;
 
 struct NmeaInputOptions {
