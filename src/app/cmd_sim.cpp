@@ -270,19 +270,14 @@ int write_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig& 
   }
   SimRow row;
   std::size_t rows = 0;
-  try {
-    while (sim->next(&row)) {
-      if (nmea) {
-        nmea->write(row);
-      } else {
-        csv->write(row);
-      }
-      ++rows;
-    }
-  } catch (const std::runtime_error& e) {  // a value no NMEA sentence can hold
-    spdlog::error("{}", e.what());
-    return kExitFailure;
-  }
+  const bool written = write_rows(
+      [&] {
+        if (!sim->next(&row)) return false;
+        nmea ? nmea->write(row) : csv->write(row);
+        return true;
+      },
+      &rows);
+  if (!written) return kExitFailure;
   try {
     output->commit();
   } catch (const io::OutputError& e) {

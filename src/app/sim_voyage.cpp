@@ -251,19 +251,14 @@ int run_voyage_sim(const VoyageCommon& c, const VoyageArgs& a) {
   }
   sim::VoyageRow row;
   std::size_t rows = 0;
-  try {
-    while (voyage->next(&row)) {
-      if (nmea) {
-        nmea->write(row.t, row.v, row.r, row.delta, row.psi, row.u_true);
-      } else {
-        csv->write(row);
-      }
-      ++rows;
-    }
-  } catch (const std::runtime_error& e) {  // a value no NMEA sentence can hold
-    spdlog::error("{}", e.what());
-    return kExitFailure;
-  }
+  const bool written = write_rows(
+      [&] {
+        if (!voyage->next(&row)) return false;
+        nmea ? nmea->write(row.t, row.v, row.r, row.delta, row.psi, row.u_true) : csv->write(row);
+        return true;
+      },
+      &rows);
+  if (!written) return kExitFailure;
   os.flush();
   if (!os) {
     spdlog::error("{}: write failed", c.output);

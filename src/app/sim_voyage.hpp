@@ -2,11 +2,14 @@
 // the voyage simulator of src/sim (autopilot, manoeuvres, waves, wind, current, sensors).
 #pragma once
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -40,6 +43,20 @@ struct VoyageCommon {
   bool nmea = false;                ///< write NMEA sentences instead of CSV rows
   bool nmea_heading = false;        ///< --nmea: also $HEHDT
 };
+
+/// Calls write_next() (write the next row; false when there is none) until it returns false,
+/// counting the rows in *rows. False (logged) when it throws std::runtime_error: a value that
+/// no NMEA sentence can hold.
+template <class WriteNext>
+bool write_rows(WriteNext write_next, std::size_t* rows) {
+  try {
+    while (write_next()) ++*rows;
+  } catch (const std::runtime_error& e) {
+    spdlog::error("{}", e.what());
+    return false;
+  }
+  return true;
+}
 
 /// Every hull `--vessel` accepts with a voyage scenario.
 std::vector<std::string> voyage_vessel_names();

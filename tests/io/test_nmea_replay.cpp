@@ -46,6 +46,12 @@ class NmeaReplay : public ::testing::Test {
   cli::Outcome run(const std::string& args) const {
     return testing_cli::run_shell("'" + cli::kExe + "' " + args, dir_);
   }
+  /// Runs `usv-fdi sim ARGS --output NAME` in the test's folder; the log's text ("" on failure).
+  std::string sim(const std::string& args, const std::string& name) const {
+    const cli::Outcome r = run("sim " + args + " --output '" + path(name) + "'");
+    EXPECT_EQ(r.code, 0) << r.err;
+    return r.code == 0 ? cli::slurp(path(name)) : std::string();
+  }
   /// Replays `input` with `config` (relative to the repository) into the JSON records.
   std::vector<js::Value> replay(const std::string& config, const std::string& input,
                                 const std::string& extra = "", int expect_code = 0) const {
@@ -91,12 +97,9 @@ TEST_F(NmeaReplay, PaperScenarioThroughNmeaRaisesAndIsolatesBothFaultsLikeTheCsv
   // GIVEN the paper's scenario (Otter, 10 Hz) as CSV and as NMEA, noise-free as in the paper
   // and in the golden case `paper` (with the realistic noise, config/scenarios/paper.yaml
   // arms too late for the gyro fault, in both replays alike)
-  const std::string sim =
-      "sim --vessel otter --scenario paper --rate 10 --noise-scale 0 --seed 1 --output '";
-  ASSERT_EQ(run(sim + path("paper.csv") + "'").code, 0);
-  const cli::Outcome s = run(sim + path("paper.nmea") + "' --nmea");
-  ASSERT_EQ(s.code, 0) << s.err;
-  const std::string log = cli::slurp(path("paper.nmea"));
+  const std::string paper = "--vessel otter --scenario paper --rate 10 --noise-scale 0 --seed 1";
+  ASSERT_FALSE(sim(paper, "paper.csv").empty());
+  const std::string log = sim(paper + " --nmea", "paper.nmea");
   EXPECT_EQ(log.rfind("\\s:HE0001,n:1,c:1767225600*", 0), 0u) << log.substr(0, 80);
   EXPECT_TRUE(has(log, "$HEROT,") && has(log, "$AGRSA,") && has(log, "$VDVBW,"));
 
@@ -126,12 +129,10 @@ TEST_F(NmeaReplay, PaperScenarioThroughNmeaRaisesAndIsolatesBothFaultsLikeTheCsv
 }
 
 TEST_F(NmeaReplay, HealthyVoyageThroughNmeaRaisesNothing) {
-  const cli::Outcome s =
-      run("sim --vessel otter --scenario healthy --rate 10 --duration 150 --seed 1 --nmea "
-          "--nmea-heading --output '" +
-          path("healthy.nmea") + "'");
-  ASSERT_EQ(s.code, 0) << s.err;
-  EXPECT_TRUE(has(cli::slurp(path("healthy.nmea")), "$HEHDT,"));
+  EXPECT_TRUE(has(sim("--vessel otter --scenario healthy --rate 10 --duration 150 --seed 1 "
+                      "--nmea --nmea-heading",
+                      "healthy.nmea"),
+                  "$HEHDT,"));
   const auto recs = replay("config/vessels/otter.yaml", path("healthy.nmea"));
   EXPECT_TRUE(raised(recs).empty());
   EXPECT_EQ(recs.back().at("samples").num, 1501.0);
@@ -140,11 +141,8 @@ TEST_F(NmeaReplay, HealthyVoyageThroughNmeaRaisesNothing) {
 }
 
 TEST_F(NmeaReplay, CorruptedLinesAreCountedByReasonAndNeverStopTheReplay) {
-  ASSERT_EQ(run("sim --vessel otter --scenario paper --rate 10 --duration 30 --nmea --output '" +
-                path("short.nmea") + "'")
-                .code,
-            0);
-  std::istringstream in(cli::slurp(path("short.nmea")));
+  std::istringstream in(
+      sim("--vessel otter --scenario paper --rate 10 --duration 30 --nmea", "short.nmea"));
   std::vector<std::string> lines;
   for (std::string l; std::getline(in, l);) lines.push_back(l + "\n");
   ASSERT_EQ(lines.size(), 903u);  // 301 samples, 3 sentences each
@@ -201,10 +199,8 @@ TEST_F(NmeaReplay, CorruptedLinesAreCountedByReasonAndNeverStopTheReplay) {
 }
 
 TEST_F(NmeaReplay, FormatNmeaReadsALogOfAnyName) {
-  ASSERT_EQ(run("sim --vessel otter --scenario paper --rate 10 --duration 10 --nmea --output '" +
-                path("log.txt") + "'")
-                .code,
-            0);
+  ASSERT_FALSE(
+      sim("--vessel otter --scenario paper --rate 10 --duration 10 --nmea", "log.txt").empty());
   const auto recs = replay("config/scenarios/paper.yaml", path("log.txt"), "--format nmea");
   EXPECT_EQ(recs.back().at("samples").num, 101.0);
 
@@ -231,12 +227,8 @@ TEST_F(NmeaReplay, FormatNmeaReadsALogOfAnyName) {
 TEST_F(NmeaReplay, StarboardTurnOfAVoyageIsPositiveRotAndRsa) {
   // The voyage `turn` on the Otter: hold course, then a turning circle to starboard (the
   // default --side) with the rudder hard over from about 20 s to 55 s.
-  const cli::Outcome s =
-      run("sim --vessel otter --scenario turn --rate 10 --duration 60 --nmea "
-          "--output '" +
-          path("turn.nmea") + "'");
-  ASSERT_EQ(s.code, 0) << s.err;
-  std::istringstream in(cli::slurp(path("turn.nmea")));
+  std::istringstream in(
+      sim("--vessel otter --scenario turn --rate 10 --duration 60 --nmea", "turn.nmea"));
   std::size_t k = 0, rot = 0, rsa = 0;
   for (std::string l; std::getline(in, l); ++k) {
     const std::string x = l.substr(l.find('$'));
