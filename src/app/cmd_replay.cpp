@@ -1,10 +1,14 @@
-// usv-fdi replay --config FILE --input FILE.csv [--output FILE.jsonl]
+// usv-fdi replay --config FILE --input FILE.csv|FILE.nmea [--format csv|nmea] [--output FILE.jsonl]
 #include <spdlog/spdlog.h>
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <ctime>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -13,6 +17,7 @@
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/io/jsonl.hpp"
+#include "usv_fdi/io/nmea_log.hpp"
 #include "usv_fdi/io/output_file.hpp"
 #include "usv_fdi/io/replay.hpp"
 
@@ -22,9 +27,51 @@ namespace {
 struct ReplayArgs {
   std::string config;
   std::string input;
-  std::string output;  ///< empty or "-": stdout
+  std::string output;               ///< empty or "-": stdout
+  std::string format = "auto";      ///< auto (by the extension), csv or nmea
+  std::optional<double> nmea_rate;  ///< NMEA: sentence cycle and sample rate [Hz]
   io::ReplayOptions options;
 };
+
+/// Whether the input is an NMEA log: --format nmea, or --format auto and a .nmea extension.
+bool is_nmea(const ReplayArgs& a) {
+  if (a.format != "auto") return a.format == "nmea";
+  const std::string ext = ".nmea";
+  return a.input.size() > ext.size() &&
+         a.input.compare(a.input.size() - ext.size(), ext.size(), ext) == 0;
+}
+
+/// Logs the NMEA lines that could not be used; an error (kExitRejected) when they are most of
+/// the lines, or when no sample could be assembled from the log.
+int report_nmea_lines(const std::string& file, const io::NmeaLineStats& st, std::size_t samples) {
+  std::string first;
+  std::size_t first_line = 0;
+  for (const auto& [reason, c] : st.reasons) {
+    if (first_line == 0 || c.first_line < first_line) {
+      first_line = c.first_line;
+      first = fmt::format("{}:{}: {}: {}", file, c.first_line, reason, c.first_text);
+    }
+  }
+  const std::string what =
+      st.unusable == 0
+          ? std::string()
+          : fmt::format("{} of {} lines ({:.1f} %) unusable: {}; the first: {}", st.unusable,
+                        st.lines, 100.0 * static_cast<double>(st.unusable) / st.lines,
+                        st.describe(), first);
+  if (2 * st.unusable > st.lines || samples == 0) {
+    spdlog::error("{}: {}{}. Detection did not see most of the recording (exit {})", file,
+                  what.empty() ? fmt::format("no sample in {} lines", st.lines) : what,
+                  samples == 0 && !what.empty() ? " (no sample assembled)" : "",
+                  static_cast<int>(kExitRejected));
+    return kExitRejected;
+  }
+  if (!what.empty()) spdlog::warn("{}: {}", file, what);
+  spdlog::info(
+      "{}: {} lines: {} used (ROT, RSA, VBW, VTG), {} ignored (other sentences), {} "
+      "unusable",
+      file, st.lines, st.used, st.ignored, st.unusable);
+  return kExitOk;
+}
 
 /// An error message when the output would overwrite an input, else empty.
 std::string output_conflict(const ReplayArgs& a) {
@@ -85,9 +132,22 @@ int run_replay(const ReplayArgs& a) {
     return kExitConfig;
   }
 
-  std::unique_ptr<io::CsvSampleReader> input;
+  const bool nmea = is_nmea(a);
+  std::unique_ptr<io::CsvSampleReader> csv;
+  std::unique_ptr<io::NmeaSampleReader> log;
   try {
-    input = std::make_unique<io::CsvSampleReader>(a.input);
+    if (nmea) {
+      io::NmeaInputOptions o;
+      o.b2 = cfg.B(1);
+      if (a.nmea_rate) {
+        o.grid_rate_hz = *a.nmea_rate;
+        o.cycle_rate_hz = a.nmea_rate;
+      }
+      o.max_age_s = std::max(1.0, 2.5 / o.grid_rate_hz);
+      log = std::make_unique<io::NmeaSampleReader>(a.input, o);
+    } else {
+      csv = std::make_unique<io::CsvSampleReader>(a.input);
+    }
   } catch (const io::InputError& e) {
     spdlog::error("{}", e.what());
     return kExitInput;
@@ -100,10 +160,11 @@ int run_replay(const ReplayArgs& a) {
   int code = kExitOk;
   io::RunSummary sum;
   try {
-    sum = io::replay(cfg, *input, writer, a.options);
+    sum =
+        nmea ? io::replay(cfg, *log, writer, a.options) : io::replay(cfg, *csv, writer, a.options);
   } catch (const io::InputError& e) {
     spdlog::error("{} (the records of the {} rows before it were written)", e.what(),
-                  input->rows());
+                  nmea ? log->rows() : csv->rows());
     code = kExitInput;
   }
   try {
@@ -113,6 +174,16 @@ int run_replay(const ReplayArgs& a) {
     return kExitOutput;
   }
   for (const std::string& w : sum.warnings) spdlog::warn("{}: {}", a.input, w);
+  if (nmea && log->first_tag_ms()) {
+    const std::int64_t ms = *log->first_tag_ms();
+    const std::time_t secs = static_cast<std::time_t>(ms / 1000);
+    std::tm utc{};
+    char when[32] = "?";
+    if (::gmtime_r(&secs, &utc) != nullptr) std::strftime(when, sizeof when, "%FT%T", &utc);
+    spdlog::info("{}: t = 0 is the first TAG time c: {}.{:03d}Z (UNIX {} ms)", a.input, when,
+                 static_cast<int>(ms % 1000), ms);
+  }
+  if (code == kExitOk && nmea) code = report_nmea_lines(a.input, log->stats(), log->rows());
   if (code == kExitOk) code = report_rejections(a.input, sum);
   if ((code == kExitOk || code == kExitRejected) && !sum.not_converged.empty()) {
     spdlog::warn(
@@ -136,13 +207,26 @@ void register_replay_command(CommandRegistry& registry) {
   auto args = std::make_shared<ReplayArgs>();
   CLI::App* sub = registry.add(
       "replay",
-      "Replay a CSV of samples (columns t,v,r,delta) through the FDI engine and write JSON "
-      "Lines records (event, estimate, summary). Exit codes: 2 config error, 3 input error, "
-      "4 output error (also: the output is the input or the config file), 5 most rows "
-      "rejected (time missing or not increasing).",
+      "Replay a CSV of samples (columns t,v,r,delta) or an NMEA 0183 / IEC 61162-450 log "
+      "(ROT, RSA, VBW, VTG; chosen by the .nmea extension or --format nmea) through the FDI "
+      "engine and write JSON Lines records (event, estimate, summary). Exit codes: 2 config "
+      "error, 3 input error, 4 output error (also: the output is the input or the config "
+      "file), 5 most rows rejected (time missing or not increasing) or most NMEA lines "
+      "unusable.",
       [args] { return run_replay(*args); });
   sub->add_option("--config", args->config, "engine configuration (YAML)")->required();
-  sub->add_option("--input", args->input, "input CSV (header with t,v,r,delta)")->required();
+  sub->add_option("--input", args->input,
+                  "input CSV (header with t,v,r,delta), or NMEA log (*.nmea or --format nmea)")
+      ->required();
+  sub->add_option("--format", args->format,
+                  "input format: auto (nmea for a file name ending in .nmea, else csv), csv, nmea")
+      ->check(CLI::IsMember({"auto", "csv", "nmea"}))
+      ->capture_default_str();
+  sub->add_option("--nmea-rate", args->nmea_rate,
+                  "NMEA: rate of the assembled samples [Hz] (default 10), and the sentence rate "
+                  "that times a log without TAG block times (c:): one cycle per repeated "
+                  "sentence")
+      ->check(CLI::PositiveNumber);
   sub->add_option("--output", args->output, "output JSON Lines file (default: stdout)");
   sub->add_option("--estimate-period", args->options.estimate_period,
                   "data time between estimate records [s]")

@@ -21,6 +21,7 @@
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/csv.hpp"
+#include "usv_fdi/io/nmea_log.hpp"
 #include "usv_fdi/io/output_file.hpp"
 #include "usv_fdi/io/scenarios.hpp"
 #include "usv_fdi/sim/voyage.hpp"
@@ -244,8 +245,8 @@ int publish_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig
 }
 #endif
 
-/// The classic scenario into the --output CSV (a temporary file renamed at the end).
-int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
+/// The classic scenario into the --output CSV or NMEA log (a temporary file renamed at the end).
+int write_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
   std::unique_ptr<Simulator> sim;
   try {
     sim = std::make_unique<Simulator>(c);
@@ -256,13 +257,27 @@ int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConf
   const bool to_stdout = a.output == "-";
   const std::unique_ptr<io::OutputFile> output = open_output(a.output);
   if (output == nullptr) return kExitOutput;
-  io::SimCsvWriter writer(output->stream());
+  std::optional<io::SimCsvWriter> csv;
+  std::optional<io::NmeaSimWriter> nmea;
+  if (a.nmea) {
+    io::NmeaOutputOptions o;
+    o.b2 = vessel.B(1);
+    o.surge_speed = vessel.u0;
+    o.heading = a.nmea_heading;
+    nmea.emplace(output->stream(), o);
+  } else {
+    csv.emplace(output->stream());
+  }
   SimRow row;
   std::size_t rows = 0;
-  while (sim->next(&row)) {
-    writer.write(row);
-    ++rows;
-  }
+  const bool written = write_rows(
+      [&] {
+        if (!sim->next(&row)) return false;
+        nmea ? nmea->write(row) : csv->write(row);
+        return true;
+      },
+      &rows);
+  if (!written) return kExitFailure;
   try {
     output->commit();
   } catch (const io::OutputError& e) {
@@ -270,11 +285,12 @@ int write_classic_csv(const SimArgs& a, const VesselModel& vessel, const SimConf
     return kExitOutput;
   }
   spdlog::info(
-      "{}: {} rows, vessel {}, scenario {}, {} Hz, {} s, seed {}, {} steering, noise "
+      "{}: {} {}, vessel {}, scenario {}, {} Hz, {} s, seed {}, {} steering, noise "
       "sigma_v {:.3g} m/s sigma_r {:.3g} rad/s",
-      to_stdout ? std::string("stdout") : a.output, rows, vessel.name, a.scenario, c.rate_hz,
-      c.duration, c.seed, c.steering == Steering::kSine ? "sine" : "autopilot", c.sigma_v,
-      c.sigma_r);
+      to_stdout ? std::string("stdout") : a.output, rows,
+      a.nmea ? "samples as NMEA (ROT, RSA, VBW with TAG times)" : "rows", vessel.name, a.scenario,
+      c.rate_hz, c.duration, c.seed, c.steering == Steering::kSine ? "sine" : "autopilot",
+      c.sigma_v, c.sigma_r);
   for (const FaultInjection& f : c.faults) spdlog::info("  fault {}", io::format_fault_spec(f));
   if (c.faults.empty()) spdlog::info("  no faults");
   return kExitOk;
@@ -305,7 +321,7 @@ int run_sim(const SimArgs& a) {
     return kExitUsage;
   }
 #endif
-  return write_classic_csv(a, vessel, c);
+  return write_classic(a, vessel, c);
 }
 
 /// --vessel, --scenario, --rate, --duration, --seed, --fault.
@@ -382,14 +398,20 @@ void add_publish_options(CLI::App* sub, SimArgs* args) {
 
 void register_sim_command(CommandRegistry& registry) {
   auto args = std::make_shared<SimArgs>();
-  CLI::App* sub =
-      registry.add("sim",
-                   "Simulate a vessel with optional INS faults and write CSV rows "
-                   "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
-                   "scenarios add u and more; %.17g)",
-                   [args] { return run_sim(*args); });
+  CLI::App* sub = registry.add(
+      "sim",
+      "Simulate a vessel with optional INS faults and write CSV rows "
+      "(t,v,r,delta,v_true,r_true,delta_true,psi,psi_ref,fault_a,fault_g; voyage "
+      "scenarios add u and more; %.17g), or with --nmea NMEA 0183 sentences with TAG times",
+      [args] { return run_sim(*args); });
   add_scenario_options(sub, args.get());
   add_voyage_options(sub, &args->voyage);
+  sub->add_flag("--nmea", args->nmea,
+                "write NMEA 0183 sentences instead of CSV: per sample "
+                "$HEROT (r, deg/min, 3 decimals), $AGRSA (delta, deg, 3 decimals, RSA sign: > 0 "
+                "bow to starboard), $VDVBW (v and the vessel's nominal u, kn, 4 decimals), each "
+                "after a TAG block with c: = 2026-01-01T00:00:00Z + t (ms)");
+  sub->add_flag("--nmea-heading", args->nmea_heading, "--nmea: also $HEHDT (psi, deg)");
   sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
       ->check(CLI::IsMember({"autopilot", "sine"}));
   sub->add_option("--noise-scale", args->noise_scale,

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 
 #include "command.hpp"
 #include "usv_fdi/core/vessel.hpp"
 #include "usv_fdi/io/csv.hpp"
+#include "usv_fdi/io/nmea_log.hpp"
 #include "usv_fdi/io/scenarios.hpp"
 #include "usv_fdi/sim/voyage.hpp"
 
@@ -235,21 +237,36 @@ int run_voyage_sim(const VoyageCommon& c, const VoyageArgs& a) {
     }
   }
   std::ostream& os = to_stdout ? std::cout : file;
-  sim::VoyageCsvWriter writer(os, cfg.sensors);
+  const sim::Linearisation& lin = voyage->linearisation();
+  std::optional<sim::VoyageCsvWriter> csv;
+  std::optional<io::NmeaSimWriter> nmea;
+  if (c.nmea) {
+    io::NmeaOutputOptions o;
+    o.b2 = lin.B(1);  // the sign of delta that a replay with this hull's B reads back
+    o.surge_speed = lin.u0;
+    o.heading = c.nmea_heading;
+    nmea.emplace(os, o);
+  } else {
+    csv.emplace(os, cfg.sensors);
+  }
   sim::VoyageRow row;
   std::size_t rows = 0;
-  while (voyage->next(&row)) {
-    writer.write(row);
-    ++rows;
-  }
+  const bool written = write_rows(
+      [&] {
+        if (!voyage->next(&row)) return false;
+        nmea ? nmea->write(row.t, row.v, row.r, row.delta, row.psi, row.u_true) : csv->write(row);
+        return true;
+      },
+      &rows);
+  if (!written) return kExitFailure;
   os.flush();
   if (!os) {
     spdlog::error("{}: write failed", c.output);
     return kExitOutput;
   }
-  const sim::Linearisation& lin = voyage->linearisation();
-  spdlog::info("{}: {} rows, hull {} ({}), scenario {}, {} Hz, {} s, seed {}, U0 {:.3g} m/s",
-               to_stdout ? std::string("stdout") : c.output, rows, hull->name(),
+  spdlog::info("{}: {} {}, hull {} ({}), scenario {}, {} Hz, {} s, seed {}, U0 {:.3g} m/s",
+               to_stdout ? std::string("stdout") : c.output, rows,
+               c.nmea ? "samples as NMEA (ROT, RSA, VBW with TAG times)" : "rows", hull->name(),
                hull->nonlinear() ? "nonlinear" : "linear", c.scenario, cfg.rate_hz, cfg.duration,
                cfg.seed, lin.u0);
   spdlog::info("  linearised B = [{:.6g}, {:.6g}], A = [{:.6g}, {:.6g}, {:.6g}, {:.6g}]", lin.B(0),

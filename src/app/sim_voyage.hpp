@@ -2,11 +2,14 @@
 // the voyage simulator of src/sim (autopilot, manoeuvres, waves, wind, current, sensors).
 #pragma once
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -37,14 +40,30 @@ struct VoyageCommon {
   std::uint64_t seed = 1;
   double noise_scale = 1.0;
   std::vector<std::string> faults;  ///< channel units, as in the classic scenarios
+  bool nmea = false;                ///< write NMEA sentences instead of CSV rows
+  bool nmea_heading = false;        ///< --nmea: also $HEHDT
 };
+
+/// Calls write_next() (write the next row; false when there is none) until it returns false,
+/// counting the rows in *rows. False (logged) when it throws std::runtime_error: a value that
+/// no NMEA sentence can hold.
+template <class WriteNext>
+bool write_rows(WriteNext write_next, std::size_t* rows) {
+  try {
+    while (write_next()) ++*rows;
+  } catch (const std::runtime_error& e) {
+    spdlog::error("{}", e.what());
+    return false;
+  }
+  return true;
+}
 
 /// Every hull `--vessel` accepts with a voyage scenario.
 std::vector<std::string> voyage_vessel_names();
 /// The hull of that name (the zoo's, else a shipped vessel as a linear hull); nullptr if none.
 std::shared_ptr<const sim::Hull> find_voyage_hull(const std::string& name);
 void add_voyage_options(CLI::App* sub, VoyageArgs* a);
-/// Runs the voyage and writes its CSV; returns the exit code.
+/// Runs the voyage and writes its CSV (or NMEA log); returns the exit code.
 int run_voyage_sim(const VoyageCommon& common, const VoyageArgs& a);
 
 }  // namespace usvfdi::app

@@ -123,10 +123,10 @@ class Replay {
   FaultState latched_[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};
 };
 
-}  // namespace
-
-RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& out,
-                  const ReplayOptions& options) {
+/// The replay of any reader with next(Sample*) and line() (CSV or NMEA).
+template <class Reader>
+RunSummary replay_from(const EngineConfig& cfg, Reader& input, JsonlWriter& out,
+                       const ReplayOptions& options) {
   Replay run(cfg, out, options);
   Sample s;
   try {
@@ -143,6 +143,18 @@ RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& 
   out.summary(sum);
   out.flush();
   return sum;
+}
+
+}  // namespace
+
+RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& out,
+                  const ReplayOptions& options) {
+  return replay_from(cfg, input, out, options);
+}
+
+RunSummary replay(const EngineConfig& cfg, NmeaSampleReader& input, JsonlWriter& out,
+                  const ReplayOptions& options) {
+  return replay_from(cfg, input, out, options);
 }
 
 }  // namespace usvfdi::io

@@ -1,9 +1,11 @@
-// Offline replay: CSV samples through FdiEngine into JSON Lines records.
+// Offline replay: CSV samples (or samples assembled from an NMEA log) through FdiEngine into JSON
+// Lines records.
 #pragma once
 
 #include "usv_fdi/core/engine.hpp"
 #include "usv_fdi/io/csv.hpp"
 #include "usv_fdi/io/jsonl.hpp"
+#include "usv_fdi/io/nmea_log.hpp"
 
 namespace usvfdi::io {
 
@@ -21,6 +23,11 @@ struct ReplayOptions {
 /// On a malformed row, whatever was produced is written, then a final estimate and a
 /// summary with complete = false, and the InputError is rethrown.
 RunSummary replay(const EngineConfig& cfg, CsvSampleReader& input, JsonlWriter& out,
+                  const ReplayOptions& options = {});
+
+/// The same from an NMEA log: one sample per grid time of the reader (its bad lines are
+/// counted in input.stats(), never thrown).
+RunSummary replay(const EngineConfig& cfg, NmeaSampleReader& input, JsonlWriter& out,
                   const ReplayOptions& options = {});
 
 }  // namespace usvfdi::io
