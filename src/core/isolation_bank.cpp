@@ -108,13 +108,14 @@ double Isolator::learned_threshold(std::vector<double>* healthy) const {
 }
 
 double Isolator::history_threshold(double healthy_max) const {
-  // history_margin x the healthy maximum, but a windowed mean of clipped squares saturates
-  // at clip^2: past reachable_threshold() the margin shrinks to kMinHistoryMargin, so that
-  // a fault that pegs the statistic is still seen (a bar above clip^2 made a channel blind:
-  // a gyro drift of 10 sigma in 10 s on the Otter was never raised, J at 16 against 16.1).
+  // history_margin x the healthy maximum; but a windowed mean of clipped squares saturates
+  // at clip^2, and a bar at or above it made the channel blind without a word (a gyro drift
+  // of 10 sigma in 10 s on the Otter was never raised, J at 16 against 16.1). Such a bar
+  // becomes the highest threshold the statistic reaches with margin, or kMinHistoryMargin x
+  // the healthy maximum when that is higher: a fault that pegs the statistic is seen.
   constexpr double kMinHistoryMargin = 1.05;
   const double bar = p_.history_margin * healthy_max;
-  if (bar <= reachable_threshold()) return bar;
+  if (bar < 0.98 * p_.clip * p_.clip) return bar;
   return std::max(reachable_threshold(), kMinHistoryMargin * healthy_max);
 }
 
