@@ -124,7 +124,8 @@ std::size_t Isolator::window_samples(double dt) const {
   return static_cast<std::size_t>(std::max<double>(n, p_.min_window_samples));
 }
 
-void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok) {
+void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok,
+                         const Vec2& rudder) {
   if (dt > p_.stale_timeout) {
     // A gap: restart the observers from the measurements and let them settle again (the
     // monitors stop: the cross residual alone holds a raised fault after a gap).
@@ -143,10 +144,6 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
     b->settle_until = s.t + settle;
     return;
   }
-  const double d = within(prev_.delta, p_.max_abs_delta) ? prev_.delta
-                   : std::isfinite(last_delta_)          ? last_delta_
-                                                         : 0.0;
-  const double d_new = within(s.delta, p_.max_abs_delta) ? s.delta : d;
   // While a sensor is faulty, its dedicated observer is driven by the other observer's
   // estimate of that channel instead (reconfiguration): it keeps tracking the vessel, so
   // the fault stays fully visible and the residual is clean the moment the fault ends.
@@ -159,8 +156,8 @@ void Isolator::propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_
   const bool use_r = pr || (fg && !fa);
   // At speed ratio s: A0 over the vessel's own time s dt, driven by s^(k-1) delta.
   const double h = st_.speed_ratio * dt, k = in_obs_;
-  b->v.step(h, k * d, k * d_new, yv, use_v);
-  b->g.step(h, k * d, k * d_new, yr, use_r);
+  b->v.step(h, k * rudder(0), k * rudder(1), yv, use_v);
+  b->g.step(h, k * rudder(0), k * rudder(1), yr, use_r);
 }
 
 bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
@@ -238,16 +235,18 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
 void Isolator::propagate_observers(const Sample& s, double dt, bool v_ok, bool r_ok) {
   // Propagate the observers over [t_{k-1}, t_k]: the rudder linear between its samples, the
   // driving measurements those of t_{k-1}.
-  propagate(&act_, s, dt, v_ok, r_ok);
-  if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok);
+  // The rudder at t_{k-1} and t_k; one that is missing or implausible holds the last usable
+  // value (0 before any).
   const double dp = within(prev_.delta, p_.max_abs_delta) ? prev_.delta
                     : std::isfinite(last_delta_)          ? last_delta_
                                                           : 0.0;
-  const double dn = within(s.delta, p_.max_abs_delta) ? s.delta : dp;
+  const Vec2 rudder(dp, within(s.delta, p_.max_abs_delta) ? s.delta : dp);
+  propagate(&act_, s, dt, v_ok, r_ok, rudder);
+  if (has_shadow_) propagate(&shadow_, s, dt, v_ok, r_ok, rudder);
   for (int c = 0; c < 2; ++c) {
     if (!chan_[c].mon_on) continue;
     const double y = c == kV ? prev_.v : prev_.r;
-    chan_[c].mon.step(st_.speed_ratio * dt, in_obs_ * dp, in_obs_ * dn, y,
+    chan_[c].mon.step(st_.speed_ratio * dt, in_obs_ * rudder(0), in_obs_ * rudder(1), y,
                       within(y, c == kV ? p_.max_abs_v : p_.max_abs_r));
   }
 }

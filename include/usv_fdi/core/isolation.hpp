@@ -279,7 +279,8 @@ class Isolator {
   };
 
   bool design(const Mat2& A, Bank* b);
-  void propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok);
+  /// rudder: the rudder at t_{k-1} and t_k that drives the observers over the step.
+  void propagate(Bank* b, const Sample& s, double dt, bool v_ok, bool r_ok, const Vec2& rudder);
   /// Learning and evaluation windows of one bank for one sample. Fills raw (structured and
   /// cross residuals) and sw (whitened structured, NaN where unusable). Returns false while
   /// the bank settles (nothing evaluated).
