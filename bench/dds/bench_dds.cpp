@@ -2,7 +2,8 @@
 // and ratios measured side by side in one run.
 //
 //   usv_fdi_bench_dds [--faults N] [--block B] [--cpu-seconds S] [--rate HZ] [--domain D]
-//                     [--participant-profile P] [--skip-latency] [--skip-cpu]
+//                     [--participant-profile P] [--joins J] [--skip-latency] [--skip-cpu]
+//                     [--skip-late-join]
 //
 // 1. Latency. Two responders run as separate processes on loopback (UDPv4 127.0.0.1,
 //    participant profile usv_fdi_participant_loopback), each on its own partition:
@@ -21,6 +22,14 @@
 //    one stream of simulated Otter data (autopilot, realistic noise) at HZ (default 100) in
 //    real time. CPU = (utime+stime) over S seconds after a 5 s warm-up, from /proc/<pid>/stat;
 //    RSS = VmRSS at the end and VmHWM, from /proc/<pid>/status.
+//
+// 3. Late join. Three `usv_fdi_bench_dds latched` processes each hold the latched state of one
+//    vessel (two FaultEvent instances and one FdiStatus, written once), each on its own
+//    partition: with the shipped profiles; with Fast DDS's default participant announcement
+//    period (3 s); with that and the default writer heartbeat period (3 s), as shipped before.
+//    The driver joins each in turn JOINS times: a new participant with the monitor's reader
+//    profiles, timed from the readers' creation to their match and to the take of all three
+//    latched samples.
 //
 // Exit code 0 when it completed (targets are reported, not enforced), 1 on error.
 #include <fcntl.h>
@@ -74,13 +83,17 @@ struct Options {
   std::string participant = dds::profiles::kParticipantLoopback;
   bool latency = true;
   bool cpu = true;
-  // echo mode
+  bool late_join = true;
+  int joins = 40;
+  // echo and latched modes
   std::string partition;
+  int heartbeat_ms = 0;  ///< latched mode: 0 keeps the writer profiles' heartbeat period
+  std::string profiles = USV_FDI_QOS_PROFILES;
 };
 
 dds::DdsConfig dds_config(const Options& o, const std::string& partition) {
   dds::DdsConfig c;
-  c.profiles_file = USV_FDI_QOS_PROFILES;
+  c.profiles_file = o.profiles;
   c.domain_id = o.domain;
   c.participant_profile = o.participant;
   c.publisher_partitions = {partition};
@@ -137,6 +150,60 @@ int run_echo(const Options& o) {
   ctx.create_reader(dds::TopicId::kIns, dds::profiles::kInsReaderBestEffort, &echo,
                     fdds::StatusMask::data_available());
   std::printf("echo ready\n");
+  std::fflush(stdout);
+  int sig = 0;
+  while (sig <= 0) {
+    timespec ts{1, 0};
+    sig = sigtimedwait(&set, nullptr, &ts);
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------ latched (plain DDS)
+
+/// A writer from `profile`, with the heartbeat period overridden when heartbeat_ms > 0.
+fdds::DataWriter& latched_writer(dds::DdsContext& ctx, dds::TopicId topic, const char* profile,
+                                 int heartbeat_ms) {
+  if (heartbeat_ms <= 0) return ctx.create_writer(topic, profile);
+  fdds::DataWriterQos q;
+  if (ctx.publisher().get_datawriter_qos_from_profile(profile, q) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error(std::string("no data writer profile ") + profile);
+  }
+  q.reliable_writer_qos().times.heartbeatPeriod =
+      eprosima::fastrtps::Duration_t(heartbeat_ms / 1000, (heartbeat_ms % 1000) * 1000000u);
+  fdds::DataWriter* w = ctx.publisher().create_datawriter(&ctx.topic(topic), q);
+  if (w == nullptr) throw std::runtime_error(std::string("cannot create writer ") + profile);
+  return *w;
+}
+
+/// Holds one vessel's latched state: a raised accelerometer and a raised gyro FaultEvent and
+/// one FdiStatus, written once, until a signal.
+int run_latched(const Options& o) {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  dds::DdsContext ctx(dds_config(o, o.partition));
+  fdds::DataWriter& ev = latched_writer(ctx, dds::TopicId::kFaultEvent,
+                                        dds::profiles::kFaultEventWriter, o.heartbeat_ms);
+  fdds::DataWriter& st =
+      latched_writer(ctx, dds::TopicId::kStatus, dds::profiles::kStatusWriter, o.heartbeat_ms);
+  for (std::uint8_t sensor = 0; sensor < 2; ++sensor) {
+    fdi::FaultEvent e;
+    e.mmsi(kMmsi);
+    e.sensor(sensor);
+    e.state(1);
+    e.kind(1);
+    e.sequence(1);
+    e.stamp(100.0);
+    dds::write(ev, e);
+  }
+  fdi::FdiStatus s;
+  s.mmsi(kMmsi);
+  s.stamp(100.0);
+  dds::write(st, s);
+  std::printf("latched ready\n");
   std::fflush(stdout);
   int sig = 0;
   while (sig <= 0) {
@@ -593,6 +660,133 @@ int run_cpu(const Driver& d) {
   return 0;
 }
 
+/// One late join: a fresh participant with the monitor's FaultEvent and FdiStatus readers on
+/// `partition`; the time [s] from the readers' creation to their match and to the take of the
+/// three latched samples (false when they did not all come within 10 s).
+bool late_join(const Options& o, const std::string& partition, double* to_match, double* to_state) {
+  dds::DdsContext ctx(dds_config(o, partition));
+  const auto t0 = Clock::now();
+  fdds::DataReader& ev =
+      ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
+  fdds::DataReader& st = ctx.create_reader(dds::TopicId::kStatus, dds::profiles::kStatusReader);
+  const auto end = t0 + std::chrono::seconds(10);
+  bool matched = false;
+  int events = 0, statuses = 0;
+  *to_match = NAN;
+  while (Clock::now() < end) {
+    if (!matched) {
+      fdds::SubscriptionMatchedStatus a, b;
+      ev.get_subscription_matched_status(a);
+      st.get_subscription_matched_status(b);
+      if (a.current_count > 0 && b.current_count > 0) {
+        matched = true;
+        *to_match = std::chrono::duration<double>(Clock::now() - t0).count();
+      }
+    }
+    fdi::FaultEvent e;
+    fdi::FdiStatus s;
+    fdds::SampleInfo info;
+    while (ev.take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) events += info.valid_data;
+    while (st.take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) statuses += info.valid_data;
+    if (events >= 2 && statuses >= 1) {
+      *to_state = std::chrono::duration<double>(Clock::now() - t0).count();
+      return matched;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return false;
+}
+
+/// The shipped profiles file without its participants' announcement periods
+/// (<leaseAnnouncement>): Fast DDS's default of 3 s.
+std::string profiles_with_default_announcements(const Driver& d) {
+  std::string xml = slurp(d.o.profiles);
+  const std::string open = "<leaseAnnouncement>", close = "</leaseAnnouncement>";
+  for (auto at = xml.find(open); at != std::string::npos; at = xml.find(open)) {
+    const auto end = xml.find(close, at);
+    if (end == std::string::npos) throw std::runtime_error("unterminated " + open);
+    xml.erase(at, end + close.size() - at);
+  }
+  const std::string path = d.dir + "/profiles_default_announcements.xml";
+  std::ofstream(path) << xml;
+  return path;
+}
+
+/// One writer set-up of the late-join run and what its joins measured [s].
+struct LateJoinVariant {
+  const char* name;
+  std::vector<std::string> args;  ///< after `latched`
+  std::string partition;
+  std::unique_ptr<Child> child;
+  std::vector<double> to_match, to_state;
+  int failed = 0;
+};
+
+/// Part 3: late joins, in turn, to the latched state of writers with the shipped profiles,
+/// with Fast DDS's default participant announcement period (3 s), and with that and the
+/// default writer heartbeat period (3 s): the profiles before the late-join change.
+int run_late_join(const Driver& d) {
+  const Options& o = d.o;
+  const std::string defaults = profiles_with_default_announcements(d);
+  std::vector<LateJoinVariant> v;
+  v.push_back({"shipped profiles", {}, "bench_join_shipped_" + d.tag, nullptr, {}, {}, 0});
+  v.push_back({"announcements 3 s",
+               {"--profiles", defaults},
+               "bench_join_ann_" + d.tag,
+               nullptr,
+               {},
+               {},
+               0});
+  v.push_back({"announcements 3 s, heartbeat 3 s",
+               {"--profiles", defaults, "--heartbeat-ms", "3000"},
+               "bench_join_both_" + d.tag,
+               nullptr,
+               {},
+               {},
+               0});
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    std::vector<std::string> head{d.self, "latched"};
+    head.insert(head.end(), v[k].args.begin(), v[k].args.end());
+    v[k].child = std::make_unique<Child>(d.command(head, v[k].partition),
+                                         d.dir + "/latched_" + std::to_string(k) + ".log");
+  }
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (!wait_for_text(d.dir + "/latched_" + std::to_string(k) + ".log", "latched ready", 15)) {
+      std::fprintf(stderr, "latched writers did not start; see %s\n", d.dir.c_str());
+      return 1;
+    }
+  }
+  for (int j = 0; j < o.joins; ++j) {
+    for (LateJoinVariant& x : v) {
+      double m = 0, t = 0;
+      if (late_join(o, x.partition, &m, &t)) {
+        x.to_match.push_back(m);
+        x.to_state.push_back(t);
+      } else {
+        ++x.failed;
+      }
+    }
+  }
+  std::printf(
+      "\n3. Late join: a new participant's FaultEvent + FdiStatus readers until the latched "
+      "state\n   (2 events + 1 status) is taken; %d joins per writer set-up, in turn\n",
+      o.joins);
+  std::printf("   %-34s %22s %22s %6s\n", "", "join -> match [ms]", "join -> state [ms]", "");
+  std::printf("   %-34s %7s %7s %7s %7s %7s %7s %6s\n", "writers", "p50", "p90", "max", "p50",
+              "p90", "max", "failed");
+  for (const LateJoinVariant& x : v) {
+    std::printf("   %-34s %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %6d\n", x.name,
+                1e3 * pct(x.to_match, 50), 1e3 * pct(x.to_match, 90), 1e3 * pct(x.to_match, 100),
+                1e3 * pct(x.to_state, 50), 1e3 * pct(x.to_state, 90), 1e3 * pct(x.to_state, 100),
+                x.failed);
+  }
+  std::printf("   join -> state, before (3 s, 3 s) / shipped: p50 %.2f, p90 %.2f\n",
+              pct(v[2].to_state, 50) / pct(v[0].to_state, 50),
+              pct(v[2].to_state, 90) / pct(v[0].to_state, 90));
+  std::fflush(stdout);
+  return 0;
+}
+
 int run_driver(const Options& o, const char* self) {
   char tmpl[] = "/tmp/usv_fdi_bench_dds_XXXXXX";
   if (mkdtemp(tmpl) == nullptr) throw std::runtime_error("mkdtemp failed");
@@ -602,13 +796,18 @@ int run_driver(const Options& o, const char* self) {
   std::fflush(stdout);
   if (o.latency && run_latency(d) != 0) return 1;
   if (o.cpu && run_cpu(d) != 0) return 1;
+  if (o.late_join && run_late_join(d) != 0) return 1;
   return 0;
 }
 
-Options parse(int argc, char** argv, bool* echo) {
+/// What this process is: the driver, or one of the responders it starts.
+enum class Role { kDriver, kEcho, kLatched };
+
+Options parse(int argc, char** argv, Role* role) {
   Options o;
-  *echo = argc > 1 && std::string(argv[1]) == "echo";
-  for (int i = *echo ? 2 : 1; i < argc; ++i) {
+  const std::string first = argc > 1 ? argv[1] : "";
+  *role = first == "echo" ? Role::kEcho : first == "latched" ? Role::kLatched : Role::kDriver;
+  for (int i = *role == Role::kDriver ? 1 : 2; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
       if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
@@ -632,14 +831,23 @@ Options parse(int argc, char** argv, bool* echo) {
       o.latency = false;
     } else if (a == "--skip-cpu") {
       o.cpu = false;
+    } else if (a == "--skip-late-join") {
+      o.late_join = false;
+    } else if (a == "--joins") {
+      o.joins = std::stoi(value());
+    } else if (a == "--profiles") {
+      o.profiles = value();
+    } else if (a == "--heartbeat-ms") {
+      o.heartbeat_ms = std::stoi(value());
     } else {
       throw std::invalid_argument("unknown option " + a);
     }
   }
-  if (o.faults < 1 || o.block < 1 || !(o.cpu_seconds > 0) || !(o.rate > 0) || o.domain > 232) {
+  if (o.faults < 1 || o.block < 1 || !(o.cpu_seconds > 0) || !(o.rate > 0) || o.domain > 232 ||
+      o.joins < 1 || o.heartbeat_ms < 0) {
     throw std::invalid_argument(
-        "--faults, --block, --cpu-seconds, --rate must be positive, "
-        "--domain 0..232");
+        "--faults, --block, --cpu-seconds, --rate, --joins must be positive, --heartbeat-ms "
+        "not negative, --domain 0..232");
   }
   return o;
 }
@@ -648,9 +856,10 @@ Options parse(int argc, char** argv, bool* echo) {
 
 int main(int argc, char** argv) {
   try {
-    bool echo = false;
-    const Options o = parse(argc, argv, &echo);
-    if (echo) return run_echo(o);
+    Role role = Role::kDriver;
+    const Options o = parse(argc, argv, &role);
+    if (role == Role::kEcho) return run_echo(o);
+    if (role == Role::kLatched) return run_latched(o);
     char self[4096];
     const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
     if (n <= 0) throw std::runtime_error("readlink /proc/self/exe failed");
