@@ -12,6 +12,7 @@ void register_vessels_command(CommandRegistry& registry);  // cmd_vessels.cpp
 void register_run_command(CommandRegistry& registry);      // cmd_run.cpp (DDS service)
 void register_monitor_command(CommandRegistry& registry);  // cmd_monitor.cpp (DDS subscriber)
 void register_health_command(CommandRegistry& registry);   // cmd_health.cpp (health check)
+void register_bridge_command(CommandRegistry& registry);   // cmd_bridge.cpp (BAM over 61162-450)
 #endif
 
 }  // namespace usvfdi::app

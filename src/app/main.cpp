@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   register_run_command(registry);
   register_monitor_command(registry);
   register_health_command(registry);
+  register_bridge_command(registry);
 #endif
 
   try {

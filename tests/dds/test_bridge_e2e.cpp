@@ -1,0 +1,305 @@
+// End-to-end test of `usv-fdi bridge`: the real sidecar, simulator and bridge, each in its own
+// process over Fast DDS on loopback; the test plays the bridge alert management system on
+// 127.0.0.1 UDP: it reads the IEC 61162-450 datagrams the bridge sends (ALF, ALC, HBT, ARC)
+// and sends ACN datagrams, good and bad.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fleet.hpp"
+#include "usv_fdi/nmea/alert.hpp"
+#include "usv_fdi/nmea/datagram.hpp"
+#include "usv_fdi/nmea/sentence.hpp"
+
+namespace usvfdi::dds::test {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using Clock = std::chrono::steady_clock;
+
+/// A UDP socket on 127.0.0.1, port chosen by the system.
+class Udp {
+ public:
+  Udp() : fd_(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0)) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (fd_ < 0 || ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+      throw std::runtime_error(std::string("udp: ") + std::strerror(errno));
+    }
+    socklen_t len = sizeof a;
+    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+    port_ = ntohs(a.sin_port);
+  }
+  ~Udp() { ::close(fd_); }
+  Udp(const Udp&) = delete;
+  Udp& operator=(const Udp&) = delete;
+  int port() const { return port_; }
+  std::string endpoint() const { return "127.0.0.1:" + std::to_string(port_); }
+
+  /// Receives one datagram within `timeout`; empty on timeout.
+  std::string receive(milliseconds timeout) const {
+    timeval tv{static_cast<time_t>(timeout.count() / 1000),
+               static_cast<suseconds_t>((timeout.count() % 1000) * 1000)};
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    char buf[2048];
+    const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+    return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
+  }
+
+  void send_to(int port, const std::string& bytes) const {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  }
+
+ private:
+  int fd_;
+  int port_ = 0;
+};
+
+/// A UDP port of 127.0.0.1 free a moment ago (for the bridge to bind).
+int free_port() {
+  Udp probe;
+  return probe.port();
+}
+
+/// What the bridge alert management system has received so far.
+struct Bam {
+  std::vector<nmea::Alf> alf;  ///< sentence 1 of each ALF message
+  std::vector<nmea::Alc> alc;
+  std::vector<nmea::Hbt> hbt;
+  std::vector<nmea::Arc> arc;
+  std::vector<std::string> bad;  ///< datagrams or lines that did not parse
+  int datagrams = 0, iec450 = 0;
+
+  void add(const std::string& bytes) {
+    ++datagrams;
+    const auto d = nmea::parse_datagram(bytes);
+    if (!d.ok()) {
+      bad.push_back(d.rejection().text);
+      return;
+    }
+    iec450 += d.value().iec450;
+    for (const auto& line : d.value().lines) {
+      if (!line.ok()) {
+        bad.push_back(line.rejection().text);
+        continue;
+      }
+      const nmea::Sentence& s = line.value().sentence;
+      if (s.formatter == "ALF") {
+        const auto x = nmea::parse_alf(s);
+        if (!x.ok()) bad.push_back(x.rejection().text);
+        if (x.ok() && x.value().sentence_number == 1) alf.push_back(x.value());
+      } else if (s.formatter == "ALC") {
+        const auto x = nmea::parse_alc(s);
+        if (x.ok()) alc.push_back(x.value());
+      } else if (s.formatter == "HBT") {
+        const auto x = nmea::parse_hbt(s);
+        if (x.ok()) hbt.push_back(x.value());
+      } else if (s.formatter == "ARC") {
+        const auto x = nmea::parse_arc(s);
+        if (x.ok()) arc.push_back(x.value());
+      }
+    }
+  }
+
+  /// The last ALF of alert `id`, or nullptr.
+  const nmea::Alf* last(long id) const {
+    for (auto it = alf.rbegin(); it != alf.rend(); ++it) {
+      if (it->alert.id == id) return &*it;
+    }
+    return nullptr;
+  }
+  bool state_is(long id, nmea::AlertState s) const {
+    const nmea::Alf* a = last(id);
+    return a != nullptr && a->state == s;
+  }
+  bool saw(long id, nmea::AlertState s) const {
+    for (const auto& a : alf) {
+      if (a.alert.id == id && a.state == s) return true;
+    }
+    return false;
+  }
+  std::string dump() const {
+    std::string out;
+    for (const auto& a : alf) {
+      out += "ALF " + std::to_string(a.alert.id) + " " +
+             std::string(1, a.state ? static_cast<char>(*a.state) : '-') + " rev " +
+             std::to_string(a.revision) + "\n";
+    }
+    for (const auto& a : arc) out += "ARC " + std::to_string(a.alert.id) + "\n";
+    for (const auto& b : bad) out += "bad: " + b + "\n";
+    return out;
+  }
+};
+
+/// Receives into `bam` until `done()` or the timeout; true when done.
+bool receive_until(const Udp& rx, Bam* bam, milliseconds timeout,
+                   const std::function<bool()>& done) {
+  const auto end = Clock::now() + timeout;
+  while (!done()) {
+    if (Clock::now() >= end) return false;
+    const std::string d = rx.receive(milliseconds(200));
+    if (!d.empty()) bam->add(d);
+  }
+  return true;
+}
+
+/// "$<body>*hh\r\n" with the right checksum.
+std::string with_checksum(const std::string& body) {
+  char hh[4];
+  std::snprintf(hh, sizeof hh, "%02X", nmea::checksum(body));
+  return "$" + body + "*" + hh + "\r\n";
+}
+
+/// An ACN datagram (IEC 61162-450, TAG source BN0001) for alert `id` of manufacturer `m`.
+std::string acn_datagram(long id, char command, const std::string& m = "UFD") {
+  nmea::Acn a;
+  a.talker = "BN";
+  a.alert.manufacturer = m;
+  a.alert.id = id;
+  a.alert.instance = 1;
+  a.command = static_cast<nmea::AlertCommand>(command);
+  nmea::TagBlock tag;
+  tag.source = "BN0001";
+  tag.line_count = 1;
+  return nmea::format_iec450_datagram(tag, {nmea::format_acn(a).value()}).value();
+}
+
+constexpr long kAccel = 3001, kGyro = 3002;
+constexpr auto V = nmea::AlertState::kActiveUnacknowledged;
+constexpr auto U = nmea::AlertState::kRectifiedUnacknowledged;
+constexpr auto N = nmea::AlertState::kNormal;
+
+TEST(BridgeEndToEnd, PaperScenarioAlertsFollowTheLifecycleAndAcnAcknowledges) {
+  // GIVEN a sidecar and a bridge adapter for one vessel; the test is the bridge's BAM system
+  Fleet f;
+  const unsigned m = 257100031;
+  Udp bam_rx, bam_tx;
+  const int acn_in = free_port();
+  f.start_service("svc", f.write_service_config("svc", m), 0);
+  f.start("bridge", {"bridge", "--mmsi", std::to_string(m), "--out", bam_rx.endpoint(), "--in",
+                     "127.0.0.1:" + std::to_string(acn_in), "--hbt-period", "0.5", "--alc-period",
+                     "1", "--ack-timeout", "5"});
+  ASSERT_TRUE(f.wait_for_log("bridge", "running", seconds(20))) << f.log("bridge");
+  Bam bam;
+  // Heartbeats and the (empty) alert list come before any fault.
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(10), [&] {
+    return !bam.hbt.empty() && !bam.alc.empty();
+  })) << f.log("bridge");
+  EXPECT_TRUE(bam.hbt.front().normal);
+  EXPECT_EQ(bam.hbt.front().interval_s, 0.5);
+  EXPECT_GT(bam.iec450, 0);
+
+  // WHEN the simulator publishes the paper's scenario (gyro bias 20-40 s, accelerometer 60-80 s)
+  f.start("sim", sim_args({"--mmsi", std::to_string(m), "--speed", "20"}));
+  // THEN each alert goes active-unacknowledged, then rectified-unacknowledged
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(60),
+                            [&] { return bam.state_is(kGyro, U) && bam.state_is(kAccel, U); }))
+      << bam.dump() << f.log("bridge") << f.log("svc");
+  EXPECT_TRUE(bam.saw(kGyro, V)) << bam.dump();
+  EXPECT_TRUE(bam.saw(kAccel, V)) << bam.dump();
+  EXPECT_FALSE(bam.saw(3003, V)) << "no unknown-sensor alert\n" << bam.dump();
+  EXPECT_TRUE(bam.bad.empty()) << bam.dump();
+  // The ALC lists both alerts with their revisions in force.
+  const int alc_before = static_cast<int>(bam.alc.size());
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(10),
+                            [&] { return static_cast<int>(bam.alc.size()) > alc_before; }));
+  ASSERT_EQ(bam.alc.back().entries.size(), 2u) << bam.dump();
+  EXPECT_EQ(bam.alc.back().entries[0].alert.id, kAccel);
+  EXPECT_EQ(bam.alc.back().entries[0].revision, bam.last(kAccel)->revision);
+
+  // WHEN bad ACNs arrive: a bad checksum, missing fields, an unknown talker's garbage, another
+  // equipment's alert, a datagram of another IEC 61162-450 type
+  std::string bad_checksum = acn_datagram(kAccel, 'A');
+  bad_checksum[bad_checksum.size() - 3] = bad_checksum[bad_checksum.size() - 3] == '0' ? '1' : '0';
+  bam_tx.send_to(acn_in, bad_checksum);
+  bam_tx.send_to(acn_in, with_checksum("BNACN,,UFD,3001"));  // fields missing
+  bam_tx.send_to(acn_in, std::string("RrUdP\0garbage", 13));
+  bam_tx.send_to(acn_in, "\x01\x02\x03 not nmea at all\r\n");
+  bam_tx.send_to(acn_in, acn_datagram(kAccel, 'A', "XYZ"));
+  // and one good ACN that acknowledges the gyro alert
+  const int gyro_rev = bam.last(kGyro)->revision;
+  bam_tx.send_to(acn_in, acn_datagram(kGyro, 'A'));
+  // THEN the gyro alert goes normal with the next revision; the accelerometer's is unchanged
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(20), [&] { return bam.state_is(kGyro, N); }))
+      << bam.dump() << f.log("bridge") << f.log("svc");
+  EXPECT_EQ(bam.last(kGyro)->revision, nmea::next_revision(gyro_rev));
+  EXPECT_TRUE(bam.state_is(kAccel, U)) << bam.dump();
+  EXPECT_TRUE(bam.arc.empty()) << "another equipment's alert is not answered\n" << bam.dump();
+  EXPECT_TRUE(f.wait_for_log("svc", "by bridge:BN0001", seconds(5))) << f.log("svc");
+
+  // WHEN the gyro alert is acknowledged again, or silenced
+  bam_tx.send_to(acn_in, acn_datagram(kGyro, 'A'));
+  bam_tx.send_to(acn_in, acn_datagram(kAccel, 'S'));
+  // THEN both are refused with ARC
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(10), [&] { return bam.arc.size() >= 2; }))
+      << bam.dump() << f.log("bridge");
+  EXPECT_EQ(bam.arc[0].alert.id, kGyro);
+  EXPECT_EQ(bam.arc[0].refused, nmea::AlertCommand::kAcknowledge);
+  EXPECT_EQ(bam.arc[1].alert.id, kAccel);
+  EXPECT_EQ(bam.arc[1].refused, nmea::AlertCommand::kSilence);
+  // WHEN the accelerometer alert's information is requested, then it is acknowledged
+  const std::size_t alf_before = bam.alf.size();
+  bam_tx.send_to(acn_in, acn_datagram(kAccel, 'Q'));
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(10), [&] {
+    for (std::size_t i = alf_before; i < bam.alf.size(); ++i) {
+      if (bam.alf[i].alert.id == kAccel) return true;
+    }
+    return false;
+  })) << bam.dump();
+  EXPECT_TRUE(bam.state_is(kAccel, U));
+  bam_tx.send_to(acn_in, acn_datagram(kAccel, 'A'));
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(20), [&] { return bam.state_is(kAccel, N); }))
+      << bam.dump() << f.log("bridge");
+
+  // THEN, stopped, the bridge has counted what did not act
+  f.process("bridge").signal(SIGTERM);
+  ASSERT_TRUE(f.process("bridge").wait_exit(seconds(10)).has_value());
+  const std::string log = f.log("bridge");
+  EXPECT_NE(log.find("1 checksum mismatch"), std::string::npos) << log;
+  EXPECT_NE(log.find("2 bad header"), std::string::npos) << log;
+  EXPECT_NE(log.find("bridge input: ACN "), std::string::npos) << "fields missing\n" << log;
+  EXPECT_NE(log.find("2 acks sent, 2 ARC"), std::string::npos) << log;
+}
+
+TEST(BridgeEndToEnd, AnAcnNoSidecarConfirmsIsAnsweredWithArc) {
+  // GIVEN a sidecar that accepts acknowledgements only from "captain", and a bridge
+  Fleet f;
+  const unsigned m = 257100032;
+  Udp bam_rx, bam_tx;
+  const int acn_in = free_port();
+  f.start_service("svc", f.write_service_config("svc", m, {"authorised_operators: [captain]"}), 0);
+  f.start("bridge", {"bridge", "--mmsi", std::to_string(m), "--out", bam_rx.endpoint(), "--in",
+                     "127.0.0.1:" + std::to_string(acn_in), "--ack-timeout", "2"});
+  ASSERT_TRUE(f.wait_for_log("bridge", "running", seconds(20))) << f.log("bridge");
+  f.start("sim", sim_args({"--mmsi", std::to_string(m), "--speed", "20"}));
+  Bam bam;
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(60), [&] { return bam.saw(kGyro, V); }))
+      << bam.dump() << f.log("bridge");
+  // WHEN the bridge acknowledges the gyro alert (as operator bridge:BN0001)
+  bam_tx.send_to(acn_in, acn_datagram(kGyro, 'A'));
+  // THEN the sidecar refuses it, and the bridge answers ARC once its wait is over
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(20), [&] { return !bam.arc.empty(); }))
+      << bam.dump() << f.log("bridge") << f.log("svc");
+  EXPECT_EQ(bam.arc[0].alert.id, kGyro);
+  EXPECT_FALSE(bam.saw(kGyro, nmea::AlertState::kActiveAcknowledged)) << bam.dump();
+  EXPECT_TRUE(f.wait_for_log("bridge", "not confirmed by the sidecar", seconds(5)));
+}
+
+}  // namespace
+}  // namespace usvfdi::dds::test
