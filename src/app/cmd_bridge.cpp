@@ -6,7 +6,8 @@
 // the source identification and line count, then the sentences):
 //   * ALF for every change of an instance (and for every instance when it starts);
 //   * ALC, the list of the alerts that are not normal, every --alc-period s;
-//   * HBT every --hbt-period s.
+//   * HBT every --hbt-period s: status A while the sidecar is heard, V (system fail) before
+//     it is first heard and when it falls silent.
 // It reads ACN datagrams (IEC 61162-450 or plain NMEA 0183 lines) and, for one of its alerts:
 // acknowledge -> a FaultAck of the revision in force to the sidecar (an ALF with the next
 // revision follows the sidecar's confirmation); request/repeat -> the alert's ALF again;
@@ -24,6 +25,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -57,6 +59,7 @@ struct BridgeArgs {
   double alc_period = 30.0;
   double hbt_period = 5.0;
   double ack_timeout = 5.0;
+  double silent_after = 5.0;
   std::string operator_prefix = "bridge";
 };
 
@@ -265,7 +268,19 @@ class Bridge {
     nmea::Hbt h;
     h.talker = a_.alerts.talker;
     h.interval_s = a_.hbt_period;
-    h.normal = true;
+    // Status A while the sidecar is heard (its periodic FdiStatus); V (system fail) before it
+    // is first heard and once it has been silent for --silent-after s: the FDI is not working.
+    const double age = view_.heard_age(a_.mmsi);
+    h.normal = age <= a_.silent_after;  // false for NaN: never heard
+    if (h.normal != equipment_normal_) {
+      equipment_normal_ = h.normal;
+      if (h.normal) {
+        spdlog::info("bridge: the sidecar of MMSI {} is heard: HBT status A", a_.mmsi);
+      } else {
+        spdlog::warn("bridge: the sidecar of MMSI {} is {}: HBT status V", a_.mmsi,
+                     std::isnan(age) ? "not heard yet" : "silent");
+      }
+    }
     h.sequence = hbt_sequence_;
     hbt_sequence_ = (hbt_sequence_ + 1) % 10;
     const auto s = nmea::format_hbt(h);
@@ -393,6 +408,7 @@ class Bridge {
   Clock::time_point next_alc_ = Clock::now(), next_hbt_ = Clock::now();
   int line_count_ = 0, alc_message_id_ = 0, hbt_sequence_ = 0;
   std::uint64_t sent_ = 0, alf_messages_ = 0, acks_sent_ = 0, arcs_ = 0;
+  bool equipment_normal_ = true;  ///< what the last HBT said
 };
 
 /// The alert settings of the command line; false (logged) when one is wrong.
@@ -448,6 +464,7 @@ int run_bridge(BridgeArgs& a) {
   }
   MonitorArgs view_args;
   view_args.mmsi = {a.mmsi};
+  view_args.silent_after = a.silent_after;
   std::unique_ptr<dds::DdsContext> ctx;
   std::unique_ptr<FleetView> view;
   std::unique_ptr<Bridge> bridge;
@@ -509,6 +526,11 @@ void register_bridge_command(CommandRegistry& registry) {
       ->capture_default_str();
   sub->add_option("--ack-timeout", args.ack_timeout,
                   "ARC when the sidecar has not confirmed an ACN's acknowledgement by then [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--silent-after", args.silent_after,
+                  "HBT status V (system fail) when the sidecar has not been heard for this long "
+                  "[s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   sub->add_option("--operator-prefix", args.operator_prefix,

@@ -194,14 +194,16 @@ TEST(BridgeEndToEnd, PaperScenarioAlertsFollowTheLifecycleAndAcnAcknowledges) {
   f.start_service("svc", f.write_service_config("svc", m), 0);
   f.start("bridge", {"bridge", "--mmsi", std::to_string(m), "--out", bam_rx.endpoint(), "--in",
                      "127.0.0.1:" + std::to_string(acn_in), "--hbt-period", "0.5", "--alc-period",
-                     "1", "--ack-timeout", "5"});
+                     "1", "--ack-timeout", "5", "--silent-after", "2"});
   ASSERT_TRUE(f.wait_for_log("bridge", "running", seconds(20))) << f.log("bridge");
   Bam bam;
-  // Heartbeats and the (empty) alert list come before any fault.
-  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(10), [&] {
-    return !bam.hbt.empty() && !bam.alc.empty();
+  // Heartbeats (status A once the sidecar is heard) and the (empty) alert list come before
+  // any fault.
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(20), [&] {
+    return !bam.hbt.empty() && bam.hbt.back().normal;
   })) << f.log("bridge");
-  EXPECT_TRUE(bam.hbt.front().normal);
+  ASSERT_FALSE(bam.alc.empty());
+  EXPECT_TRUE(bam.alc.front().entries.empty());
   EXPECT_EQ(bam.hbt.front().interval_s, 0.5);
   EXPECT_GT(bam.iec450, 0);
 
@@ -266,6 +268,12 @@ TEST(BridgeEndToEnd, PaperScenarioAlertsFollowTheLifecycleAndAcnAcknowledges) {
   bam_tx.send_to(acn_in, acn_datagram(kAccel, 'A'));
   ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(20), [&] { return bam.state_is(kAccel, N); }))
       << bam.dump() << f.log("bridge");
+
+  // WHEN the sidecar stops, THEN the heartbeat says system fail
+  f.process("svc").signal(SIGTERM);
+  ASSERT_TRUE(f.process("svc").wait_exit(seconds(10)).has_value());
+  ASSERT_TRUE(receive_until(bam_rx, &bam, seconds(20), [&] { return !bam.hbt.back().normal; }))
+      << f.log("bridge");
 
   // THEN, stopped, the bridge has counted what did not act
   f.process("bridge").signal(SIGTERM);
