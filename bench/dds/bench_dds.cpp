@@ -3,7 +3,8 @@
 //
 //   usv_fdi_bench_dds [--faults N] [--block B] [--cpu-seconds S] [--rate HZ] [--domain D]
 //                     [--participant-profile P] [--joins J] [--skip-latency] [--skip-cpu]
-//                     [--skip-late-join]
+//                     [--skip-late-join] [--shore-vessels N,N...] [--shore-seconds S]
+//                     [--skip-shore]
 //
 // 1. Latency. Two responders run as separate processes on loopback (UDPv4 127.0.0.1,
 //    participant profile usv_fdi_participant_loopback), each on its own partition:
@@ -31,6 +32,17 @@
 //    profiles, timed from the readers' creation to their match and to the take of all three
 //    latched samples.
 //
+// 4. Shore at fleet scale. For each N of --shore-vessels: a Fast DDS
+//    discovery server on 127.0.0.1 and, as its clients (the documented fleet configuration:
+//    docker/fleet_participants.xml, profile usv_fdi_fleet_udp, ROS_DISCOVERY_SERVER), a
+//    `usv-fdi monitor --json --status` and `usv-fdi emulate --vessels N` (N vessels on
+//    min(N, 10) participants, or P with N/P in the list (default 100,1000,1000/100), FdiStatus at 1
+//    Hz each, 5 fault events/s and a burst of N/10 simultaneous raises every 10 s). Reported: the
+//    time from the emulator's start until the monitor has shown every vessel; then over
+//    --shore-seconds: the monitor's CPU and RSS, and the fault event to printed line latency (the
+//    monitor's own `age_s`: wall clock at the print minus the event's write time) p50/p99/max,
+//    bursts included.
+//
 // Exit code 0 when it completed (targets are reported, not enforced), 1 on error.
 #include <fcntl.h>
 #include <signal.h>
@@ -51,6 +63,7 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -87,6 +100,10 @@ struct Options {
   int joins = 40;
   // echo and latched modes
   std::string partition;
+  bool shore = true;
+  std::vector<int> shore_vessels{100, 1000, 1000};
+  std::vector<int> shore_participants{0, 0, 100};  ///< 0: the emulator's default
+  double shore_seconds = 30.0;
   int heartbeat_ms = 0;  ///< latched mode: 0 keeps the writer profiles' heartbeat period
   std::string profiles = USV_FDI_QOS_PROFILES;
 };
@@ -787,6 +804,147 @@ int run_late_join(const Driver& d) {
   return 0;
 }
 
+/// One monitor --json line: its type, vessel and, for a fault, its age_s [s].
+struct MonitorLine {
+  bool fault = false;
+  std::uint32_t mmsi = 0;
+  double age_s = NAN;
+};
+
+bool parse_monitor_line(const std::string& line, MonitorLine* out) {
+  const auto mmsi = line.find("\"mmsi\":");
+  if (line.rfind("{\"type\":", 0) != 0 || mmsi == std::string::npos) return false;
+  out->fault = line.rfind("{\"type\":\"fault\"", 0) == 0;
+  out->mmsi = static_cast<std::uint32_t>(std::strtoul(line.c_str() + mmsi + 7, nullptr, 10));
+  const auto age = line.find("\"age_s\":");
+  out->age_s = age == std::string::npos ? NAN : std::strtod(line.c_str() + age + 8, nullptr);
+  return true;
+}
+
+/// Reads the complete lines appended to a file since the last call.
+class LineTail {
+ public:
+  explicit LineTail(std::string path) : path_(std::move(path)) {}
+  std::vector<std::string> next() {
+    std::ifstream f(path_, std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(offset_));
+    std::string chunk((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    for (auto nl = chunk.find('\n'); nl != std::string::npos; nl = chunk.find('\n', start)) {
+      lines.push_back(chunk.substr(start, nl - start));
+      start = nl + 1;
+    }
+    offset_ += start;
+    return lines;
+  }
+
+ private:
+  std::string path_;
+  std::size_t offset_ = 0;
+};
+
+/// Part 4 for one fleet size: discovery time, monitor CPU/RSS, event latency.
+int run_shore_one(const Driver& d, int vessels, int participants, int port) {
+  const Options& o = d.o;
+  const std::string fleet_xml = std::string(USV_FDI_SOURCE_DIR) + "/docker/fleet_participants.xml";
+  const std::string tag = "shore" + std::to_string(vessels);
+  // The server must not see ROS_DISCOVERY_SERVER (the 2.9 server then aborts); its clients must.
+  ::unsetenv("ROS_DISCOVERY_SERVER");
+  ::unsetenv("FASTRTPS_DEFAULT_PROFILES_FILE");
+  Child server({"/usr/bin/fast-discovery-server", "-i", "0", "-l", "127.0.0.1", "-p",
+                std::to_string(port), "-x", "usv_fdi_discovery_server_udp@" + fleet_xml},
+               d.dir + "/" + tag + "_server.log");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ::setenv("ROS_DISCOVERY_SERVER", ("127.0.0.1:" + std::to_string(port)).c_str(), 1);
+  ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", fleet_xml.c_str(), 1);
+  const std::vector<std::string> dds_args = {
+      "--domain",    std::to_string(o.domain), "--qos",
+      o.profiles,    "--participant-profile",  "usv_fdi_fleet_udp",
+      "--partition", "bench_shore_" + d.tag};
+  std::vector<std::string> mon = {USV_FDI_EXE, "monitor", "--json", "--status"};
+  mon.insert(mon.end(), dds_args.begin(), dds_args.end());
+  const std::string mon_out = d.dir + "/" + tag + "_monitor.jsonl";
+  Child monitor(mon, mon_out);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const int burst = std::max(1, vessels / 10);
+  std::vector<std::string> emu = {USV_FDI_EXE,     "emulate", "--vessels", std::to_string(vessels),
+                                  "--event-rate",  "5",       "--burst",   std::to_string(burst),
+                                  "--burst-every", "10"};
+  if (participants > 0) {
+    emu.push_back("--participants");
+    emu.push_back(std::to_string(participants));
+  }
+  emu.insert(emu.end(), dds_args.begin(), dds_args.end());
+  const auto t_start = Clock::now();
+  Child emulator(emu, d.dir + "/" + tag + "_emulate.log");
+  ::unsetenv("ROS_DISCOVERY_SERVER");
+  ::unsetenv("FASTRTPS_DEFAULT_PROFILES_FILE");
+  LineTail tail(mon_out);
+  std::set<std::uint32_t> seen;
+  double discovery_s = NAN;
+  const auto discovery_deadline = t_start + std::chrono::seconds(120);
+  while (Clock::now() < discovery_deadline) {
+    for (const std::string& l : tail.next()) {
+      MonitorLine m;
+      if (parse_monitor_line(l, &m)) seen.insert(m.mmsi);
+    }
+    if (static_cast<int>(seen.size()) >= vessels) {
+      discovery_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const ProcUsage u0 = usage(monitor.pid()), e0 = usage(emulator.pid());
+  const auto t_meas = Clock::now();
+  std::vector<double> latency;
+  std::size_t lines = 0;
+  const auto t_end = t_meas + std::chrono::duration_cast<Clock::duration>(
+                                  std::chrono::duration<double>(o.shore_seconds));
+  while (Clock::now() < t_end) {
+    for (const std::string& l : tail.next()) {
+      MonitorLine m;
+      if (!parse_monitor_line(l, &m)) continue;
+      ++lines;
+      seen.insert(m.mmsi);
+      if (m.fault && std::isfinite(m.age_s)) latency.push_back(m.age_s);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  const double wall = std::chrono::duration<double>(Clock::now() - t_meas).count();
+  const ProcUsage u1 = usage(monitor.pid()), e1 = usage(emulator.pid());
+  const int parts = participants > 0 ? participants : std::min(vessels, 10);
+  std::printf("   %5d/%-4d %9.2f %7zu %9.1f %9.1f %9.1f %8.1f %8.1f %8.1f %7zu %9.1f\n", vessels,
+              parts, discovery_s, seen.size(), 100.0 * (u1.cpu_s - u0.cpu_s) / wall, u1.rss_mb,
+              u1.hwm_mb, 1e3 * pct(latency, 50), 1e3 * pct(latency, 99), 1e3 * pct(latency, 100),
+              latency.size(), 100.0 * (e1.cpu_s - e0.cpu_s) / wall);
+  std::fflush(stdout);
+  (void)lines;
+  return 0;
+}
+
+/// Part 4: the shore at fleet scale, through a discovery server.
+int run_shore(const Driver& d) {
+  std::printf(
+      "\n4. Shore at fleet scale: usv-fdi monitor --json --status and usv-fdi emulate, both "
+      "clients of a\n   discovery server on 127.0.0.1 (docker/fleet_participants.xml); %g s "
+      "measured once every vessel is shown\n",
+      d.o.shore_seconds);
+  std::printf("   %10s %9s %7s %9s %9s %9s %8s %8s %8s %7s %9s\n", "vessels/DP", "shown [s]",
+              "shown", "mon CPU%", "RSS [MB]", "HWM [MB]", "ev p50", "ev p99", "ev max", "events",
+              "emu CPU%");
+  std::printf("   %10s %9s %7s %9s %9s %9s %8s %8s %8s %7s %9s\n", "", "", "", "", "", "", "[ms]",
+              "[ms]", "[ms]", "", "");
+  int port = 12811 + static_cast<int>(::getpid() % 1000);
+  for (std::size_t i = 0; i < d.o.shore_vessels.size(); ++i) {
+    if (run_shore_one(d, d.o.shore_vessels[i], d.o.shore_participants[i], port++) != 0) return 1;
+  }
+  std::printf(
+      "   targets at 1000 vessels: monitor < 100 %% of a core and < 200 MB, event p99 < 50 ms, "
+      "every vessel shown within 10 s\n");
+  return 0;
+}
+
 int run_driver(const Options& o, const char* self) {
   char tmpl[] = "/tmp/usv_fdi_bench_dds_XXXXXX";
   if (mkdtemp(tmpl) == nullptr) throw std::runtime_error("mkdtemp failed");
@@ -797,6 +955,7 @@ int run_driver(const Options& o, const char* self) {
   if (o.latency && run_latency(d) != 0) return 1;
   if (o.cpu && run_cpu(d) != 0) return 1;
   if (o.late_join && run_late_join(d) != 0) return 1;
+  if (o.shore && run_shore(d) != 0) return 1;
   return 0;
 }
 
@@ -831,6 +990,20 @@ Options parse(int argc, char** argv, Role* role) {
       o.latency = false;
     } else if (a == "--skip-cpu") {
       o.cpu = false;
+    } else if (a == "--skip-shore") {
+      o.shore = false;
+    } else if (a == "--shore-seconds") {
+      o.shore_seconds = std::stod(value());
+    } else if (a == "--shore-vessels") {
+      o.shore_vessels.clear();
+      o.shore_participants.clear();
+      std::stringstream list(value());
+      for (std::string n; std::getline(list, n, ',');) {
+        const auto slash = n.find('/');
+        o.shore_vessels.push_back(std::stoi(n.substr(0, slash)));
+        o.shore_participants.push_back(slash == std::string::npos ? 0
+                                                                  : std::stoi(n.substr(slash + 1)));
+      }
     } else if (a == "--skip-late-join") {
       o.late_join = false;
     } else if (a == "--joins") {
