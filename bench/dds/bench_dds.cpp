@@ -4,7 +4,7 @@
 //   usv_fdi_bench_dds [--faults N] [--block B] [--cpu-seconds S] [--rate HZ] [--domain D]
 //                     [--participant-profile P] [--joins J] [--skip-latency] [--skip-cpu]
 //                     [--skip-late-join] [--shore-vessels N,N...] [--shore-seconds S]
-//                     [--skip-shore]
+//                     [--skip-shore] [--fanout N,N...] [--fanout-seconds S] [--skip-fanout]
 //
 // 1. Latency. Two responders run as separate processes on loopback (UDPv4 127.0.0.1,
 //    participant profile usv_fdi_participant_loopback), each on its own partition:
@@ -42,6 +42,12 @@
 //    --shore-seconds: the monitor's CPU and RSS, and the fault event to printed line latency (the
 //    monitor's own `age_s`: wall clock at the print minus the event's write time) p50/p99/max,
 //    bursts included.
+//
+// 5. Input fan-out. For each N of --fanout (default 5,10,20,40): N sidecars (one MMSI each)
+//    and one `usv-fdi sim --publish` of N healthy Otter voyages at 10 Hz in real time, all on
+//    one partition; the sidecars' CPU over --fanout-seconds (after 5 s), with
+//    service.content_filter false (every sidecar receives every vessel's stream and drops the
+//    others') and true (the shipped default), one after the other.
 //
 // Exit code 0 when it completed (targets are reported, not enforced), 1 on error.
 #include <fcntl.h>
@@ -101,6 +107,9 @@ struct Options {
   // echo and latched modes
   std::string partition;
   bool shore = true;
+  bool fanout = true;
+  std::vector<int> fanout_sidecars{5, 10, 20, 40};
+  double fanout_seconds = 20.0;
   std::vector<int> shore_vessels{100, 1000, 1000};
   std::vector<int> shore_participants{0, 0, 100};  ///< 0: the emulator's default
   double shore_seconds = 30.0;
@@ -443,7 +452,8 @@ double pct(std::vector<double> x, double p) {
 /// section. For the latency run, isolation.invalid_count 1 and spike_window 0.1 s make one
 /// absurd value raise an `invalid` fault at once and 0.1 s of plausible values clear it.
 std::string write_service_config(const std::string& dir, const std::string& name,
-                                 bool invalid_raises_at_once) {
+                                 bool invalid_raises_at_once, std::uint32_t mmsi = kMmsi,
+                                 const std::string& extra = "") {
   const std::string path = dir + "/" + name + ".yaml";
   std::ofstream f(path);
   std::string otter = slurp(std::string(USV_FDI_SOURCE_DIR) + "/config/vessels/otter.yaml");
@@ -452,7 +462,7 @@ std::string write_service_config(const std::string& dir, const std::string& name
     if (at == std::string::npos) throw std::runtime_error("otter.yaml has no isolation section");
     otter.insert(at + 11, "  invalid_count: 1\n  spike_window: 0.1\n");
   }
-  f << otter << "\nservice:\n  mmsi: " << kMmsi << "\n  status_rate: 1\n";
+  f << otter << "\nservice:\n  mmsi: " << mmsi << "\n  status_rate: 1\n" << extra;
   if (invalid_raises_at_once) f << "  input_timeout: 60\n";
   if (!f) throw std::runtime_error("cannot write " + path);
   return path;
@@ -923,6 +933,90 @@ int run_shore_one(const Driver& d, int vessels, int participants, int port) {
   return 0;
 }
 
+/// Part 5 for one fleet size and filter setting: the sidecars' summed CPU [s] over the window.
+struct FanoutRun {
+  double cpu_per_sidecar = 0.0;  ///< [% of a core]
+  double fleet_total = 0.0;      ///< [% of a core]
+  double sim_cpu = 0.0;          ///< [% of a core]
+};
+
+bool run_fanout_one(const Driver& d, int n, bool filter, FanoutRun* out) {
+  const Options& o = d.o;
+  const std::string part = "bench_fanout_" + d.tag;
+  const std::string tag = "fanout" + std::to_string(n) + (filter ? "f" : "n");
+  std::vector<std::unique_ptr<Child>> sidecars;
+  std::vector<std::string> sim = {USV_FDI_EXE,
+                                  "sim",
+                                  "--publish",
+                                  "--vessel",
+                                  "otter",
+                                  "--scenario",
+                                  "healthy",
+                                  "--rate",
+                                  "10",
+                                  "--duration",
+                                  std::to_string(o.fanout_seconds + 10.0),
+                                  "--min-readers",
+                                  std::to_string(n),
+                                  "--wait-readers",
+                                  "60"};
+  for (int i = 0; i < n; ++i) {
+    const std::uint32_t mmsi = kMmsi + 100 + static_cast<std::uint32_t>(i);
+    const std::string name = tag + "_" + std::to_string(i);
+    const std::string cfg =
+        write_service_config(d.dir, name, false, mmsi,
+                             std::string("  content_filter: ") + (filter ? "true" : "false") +
+                                 "\n  input_timeout: 60\n");
+    sidecars.push_back(std::make_unique<Child>(
+        d.command({USV_FDI_EXE, "run", "--config", cfg}, part), d.dir + "/" + name + ".log"));
+    sim.push_back("--mmsi");
+    sim.push_back(std::to_string(mmsi));
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!wait_for_text(d.dir + "/" + tag + "_" + std::to_string(i) + ".log", "waiting for INS",
+                       30)) {
+      std::fprintf(stderr, "sidecar %d did not start; see %s\n", i, d.dir.c_str());
+      return false;
+    }
+  }
+  Child publisher(d.command(sim, part), d.dir + "/" + tag + "_sim.log");
+  std::this_thread::sleep_for(std::chrono::seconds(5));
+  std::vector<ProcUsage> u0;
+  for (const auto& c : sidecars) u0.push_back(usage(c->pid()));
+  const ProcUsage p0 = usage(publisher.pid());
+  const auto t0 = Clock::now();
+  std::this_thread::sleep_for(std::chrono::duration<double>(o.fanout_seconds));
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  double total = 0.0;
+  for (std::size_t i = 0; i < sidecars.size(); ++i) {
+    total += usage(sidecars[i]->pid()).cpu_s - u0[i].cpu_s;
+  }
+  out->fleet_total = 100.0 * total / wall;
+  out->cpu_per_sidecar = out->fleet_total / n;
+  out->sim_cpu = 100.0 * (usage(publisher.pid()).cpu_s - p0.cpu_s) / wall;
+  return true;
+}
+
+/// Part 5: per-sidecar CPU against fleet size, without and with the content filter.
+int run_fanout(const Driver& d) {
+  std::printf(
+      "\n5. Input fan-out: N sidecars and one sim --publish of N vessels at 10 Hz on one "
+      "partition; CPU over %g s\n",
+      d.o.fanout_seconds);
+  std::printf("   %8s %22s %22s %18s\n", "", "content_filter: false", "content_filter: true",
+              "sim --publish [%]");
+  std::printf("   %8s %11s %10s %11s %10s %9s %8s\n", "sidecars", "per sidecar", "fleet",
+              "per sidecar", "fleet", "false", "true");
+  for (int n : d.o.fanout_sidecars) {
+    FanoutRun off, on;
+    if (!run_fanout_one(d, n, false, &off) || !run_fanout_one(d, n, true, &on)) return 1;
+    std::printf("   %8d %10.2f%% %9.1f%% %10.2f%% %9.1f%% %9.1f %8.1f\n", n, off.cpu_per_sidecar,
+                off.fleet_total, on.cpu_per_sidecar, on.fleet_total, off.sim_cpu, on.sim_cpu);
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 /// Part 4: the shore at fleet scale, through a discovery server.
 int run_shore(const Driver& d) {
   std::printf(
@@ -956,6 +1050,7 @@ int run_driver(const Options& o, const char* self) {
   if (o.cpu && run_cpu(d) != 0) return 1;
   if (o.late_join && run_late_join(d) != 0) return 1;
   if (o.shore && run_shore(d) != 0) return 1;
+  if (o.fanout && run_fanout(d) != 0) return 1;
   return 0;
 }
 
@@ -990,6 +1085,14 @@ Options parse(int argc, char** argv, Role* role) {
       o.latency = false;
     } else if (a == "--skip-cpu") {
       o.cpu = false;
+    } else if (a == "--skip-fanout") {
+      o.fanout = false;
+    } else if (a == "--fanout-seconds") {
+      o.fanout_seconds = std::stod(value());
+    } else if (a == "--fanout") {
+      o.fanout_sidecars.clear();
+      std::stringstream list(value());
+      for (std::string n; std::getline(list, n, ',');) o.fanout_sidecars.push_back(std::stoi(n));
     } else if (a == "--skip-shore") {
       o.shore = false;
     } else if (a == "--shore-seconds") {

@@ -10,8 +10,11 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/qos/PublisherQos.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
+#include <fastdds/dds/topic/ContentFilteredTopic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+
 #include <fastdds/dds/topic/qos/TopicQos.hpp>
+#include "usv_fdiTypeObject.h"
 
 namespace usvfdi::dds {
 namespace {
@@ -26,6 +29,11 @@ using eprosima::fastrtps::types::ReturnCode_t;
 template <class PubSubType>
 void register_type(fdds::DomainParticipant& participant) {
   fdds::TypeSupport type(new PubSubType());
+  // The types are generated with -typeobject only so that the builtin SQL content filter
+  // (create_vessel_reader) can read their members; their TypeObject and TypeInformation are not
+  // announced in discovery, so what other participants (and other vendors) see is unchanged.
+  type->auto_fill_type_object(false);
+  type->auto_fill_type_information(false);
   const std::string name = type.get_type_name();
   if (type.register_type(&participant) != ReturnCode_t::RETCODE_OK) {
     fail("registering type '" + name + "' failed");
@@ -132,6 +140,7 @@ DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
          config_.participant_profile + "' failed");
   }
 
+  registerusv_fdiTypes();  // the TypeObjects the SQL content filter reads (idempotent)
   register_type<fdi::InsSamplePubSubType>(*participant_);
   register_type<fdi::RudderSamplePubSubType>(*participant_);
   register_type<fdi::FaultEventPubSubType>(*participant_);
@@ -169,11 +178,23 @@ bool DdsContext::secure() const {
   return false;
 }
 
+/// Readers with a content filter (a sidecar's: "mmsi = M") that one writer filters for on
+/// its side; Fast DDS's default is 32, and the readers beyond are sent every sample and filter
+/// on arrival. A fleet of sidecars on one partition needs one per sidecar.
+constexpr std::uint32_t kMaxReaderFilters = 4096;
+
 fdds::DataWriter& DdsContext::create_writer(TopicId id, const std::string& profile,
                                             fdds::DataWriterListener* listener,
                                             const fdds::StatusMask& mask) {
   fdds::Topic* t = topics_[index_of(id)];
-  fdds::DataWriter* writer = publisher_->create_datawriter_with_profile(t, profile, listener, mask);
+  fdds::DataWriterQos qos;
+  if (publisher_->get_datawriter_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK) {
+    fail("creating data writer on topic '" + t->get_name() + "': no data writer profile '" +
+         profile + "'");
+  }
+  qos.writer_resource_limits().reader_filters_allocation =
+      eprosima::fastrtps::ResourceLimitedContainerConfig(0u, kMaxReaderFilters, 1u);
+  fdds::DataWriter* writer = publisher_->create_datawriter(t, qos, listener, mask);
   if (writer == nullptr) {
     fail("creating data writer on topic '" + t->get_name() + "' from profile '" + profile +
          "' failed");
@@ -207,6 +228,26 @@ fdds::DataReader& DdsContext::create_reader(TopicId id, const std::string& profi
   if (reader == nullptr) {
     fail("creating data reader on topic '" + t->get_name() + "' from profile '" + profile +
          "' failed");
+  }
+  return *reader;
+}
+
+fdds::DataReader& DdsContext::create_vessel_reader(TopicId id, const std::string& profile,
+                                                   std::uint32_t mmsi,
+                                                   fdds::DataReaderListener* listener,
+                                                   const fdds::StatusMask& mask) {
+  fdds::Topic* t = topics_[index_of(id)];
+  const std::string name = t->get_name() + "|mmsi=" + std::to_string(mmsi);
+  fdds::ContentFilteredTopic* filtered =
+      participant_->create_contentfilteredtopic(name, t, "mmsi = %0", {std::to_string(mmsi)});
+  if (filtered == nullptr) {
+    fail("creating the content-filtered topic '" + name + "' (mmsi = " + std::to_string(mmsi) +
+         ") failed");
+  }
+  fdds::DataReader* reader =
+      subscriber_->create_datareader_with_profile(filtered, profile, listener, mask);
+  if (reader == nullptr) {
+    fail("creating data reader on topic '" + name + "' from profile '" + profile + "' failed");
   }
   return *reader;
 }

@@ -218,18 +218,24 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   for (const FaultEvent& e : restored_) pipeline_->restore(e);
   listener_ =
       std::make_unique<Listener>(pipeline_.get(), mmsi, dds_->secure() ? &dds_->peers() : nullptr);
-  DataReader& ins = dds_->create_reader(dds::TopicId::kIns,
-                                        cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
-                                                             : dds::profiles::kInsReaderBestEffort);
-  DataReader& rudder = dds_->create_reader(
-      dds::TopicId::kRudder, cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
-                                                  : dds::profiles::kRudderReaderBestEffort);
+  // The vessel's own samples only (issue 14): on a partition shared by a fleet, every sidecar
+  // used to receive every vessel's stream and drop the others' after their receipt.
+  auto reader = [this, mmsi](dds::DdsContext& ctx, dds::TopicId id,
+                             const std::string& profile) -> DataReader& {
+    return cfg_.content_filter ? ctx.create_vessel_reader(id, profile, mmsi)
+                               : ctx.create_reader(id, profile);
+  };
+  DataReader& ins = reader(*dds_, dds::TopicId::kIns,
+                           cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
+                                                : dds::profiles::kInsReaderBestEffort);
+  DataReader& rudder = reader(*dds_, dds::TopicId::kRudder,
+                              cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
+                                                   : dds::profiles::kRudderReaderBestEffort);
   // Acks are read by a participant of their own: its traffic arrives on its own port, handled
   // by its own receive thread, so a flood of acks cannot hold up (nor, through KEEP_LAST
   // histories, lose) the INS and rudder samples behind it.
   ack_dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
-  DataReader& ack =
-      ack_dds_->create_reader(dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
+  DataReader& ack = reader(*ack_dds_, dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
   listener_->ins_ = &ins;
   listener_->rudder_ = &rudder;
   listener_->ack_ = &ack;

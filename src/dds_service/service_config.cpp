@@ -106,7 +106,7 @@ void read_state_dir(const ConfigValue& v, ServiceLoad* s) {
 }
 
 /// The keys of the vessel and its DDS participant: mmsi, domain_id, qos_profiles,
-/// participant_profile, topics, partitions, reliable_inputs.
+/// participant_profile, topics, partitions, reliable_inputs, content_filter.
 void add_dds_keys(ServiceLoad* s, ConfigValue::Table* table) {
   ServiceConfig& cfg = s->cfg;
   ConfigValue::Table& t = *table;
@@ -130,6 +130,7 @@ void add_dds_keys(ServiceLoad* s, ConfigValue::Table* table) {
     cfg.dds.subscriber_partitions = cfg.dds.publisher_partitions;
   };
   t["reliable_inputs"] = [&cfg](const ConfigValue& v) { cfg.reliable_inputs = v.boolean(); };
+  t["content_filter"] = [&cfg](const ConfigValue& v) { cfg.content_filter = v.boolean(); };
 }
 
 /// The pipeline's keys: estimate_wait, status_rate, authorised_operators, input_queue,

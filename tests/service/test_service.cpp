@@ -179,6 +179,43 @@ std::vector<SimRow> paper_rows(double duration) {
   return simulate(sim);
 }
 
+// Issue 14: on a partition shared by a fleet, a sidecar's INS, rudder and ack readers are
+// content-filtered on its MMSI, so other vessels' samples are not delivered to it (and writers
+// that filter on their side do not even send them); with service.content_filter false they
+// arrive and are skipped after their receipt, counted.
+TEST(ServiceInProcess, OtherVesselsSamplesAreFilteredOutOrSkippedAfterReceipt) {
+  for (const bool filter : {true, false}) {
+    SCOPED_TRACE(filter ? "content_filter: true" : "content_filter: false");
+    const std::uint32_t m = filter ? 257200011 : 257200012;
+    ServiceConfig cfg = paper_service(m, partition() + (filter ? "_f" : "_n"));
+    cfg.content_filter = filter;
+    Logs logs;
+    FdiService svc(cfg, logs.sink());
+    svc.start();
+    Peer peer(cfg);
+    ASSERT_TRUE(peer.wait_matched(milliseconds(15000)));
+    // WHEN 100 samples of vessel M+1, then 100 of vessel M, are written (RELIABLE)
+    const std::vector<SimRow> rows = paper_rows(2.0);
+    for (std::uint64_t k = 0; k < 100; ++k) {
+      peer.write(m + 1, k + 1, rows[k].t, 1e3, 1e3, 0.0);
+    }
+    for (std::uint64_t k = 0; k < 100; ++k) {
+      peer.write(m, k + 1, rows[k].t, rows[k].v, rows[k].r, rows[k].delta);
+    }
+    // THEN the vessel's own samples are processed, and the other vessel's are filtered out
+    // (none counted) or counted as skipped (INS + rudder)
+    const std::uint64_t expected_foreign = filter ? 0u : 200u;
+    const auto deadline = std::chrono::steady_clock::now() + milliseconds(30000);
+    while (std::chrono::steady_clock::now() < deadline &&
+           (svc.status().samples < 99 || svc.foreign_samples() < expected_foreign)) {
+      std::this_thread::sleep_for(milliseconds(20));
+    }
+    EXPECT_GE(svc.status().samples, 99u);
+    EXPECT_EQ(svc.foreign_samples(), expected_foreign);
+    svc.stop();
+  }
+}
+
 TEST(ServiceInProcess, PaperScenarioOverDdsRaisesIsolatesAndClearsThenAcks) {
   // GIVEN a sidecar for vessel M and a peer participant on the same private domain/partition
   const std::uint32_t m = 257200001;
@@ -220,7 +257,9 @@ TEST(ServiceInProcess, PaperScenarioOverDdsRaisesIsolatesAndClearsThenAcks) {
     EXPECT_EQ(ev[0].sequence(), 1u);
     EXPECT_EQ(ev[0].detection_time(), cleared.detection_time());
   }
-  EXPECT_EQ(svc.foreign_samples(), 2u * 2u);  // INS + rudder of vessel M+1, twice
+  // Vessel M+1's samples never reach the listener: the readers are content-filtered on M
+  // (ServiceInProcess.OtherVesselsSamples... checks both ways).
+  EXPECT_EQ(svc.foreign_samples(), 0u);
 
   // WHEN a stale ack, an unknown ack and then the right one arrive
   const std::uint64_t inc = cleared.incarnation();

@@ -92,6 +92,16 @@ class DdsContext {
       eprosima::fastdds::dds::DataReaderListener* listener = nullptr,
       const eprosima::fastdds::dds::StatusMask& mask = eprosima::fastdds::dds::StatusMask::all());
 
+  /// Like create_reader(), for the samples of one vessel only: a content-filtered topic
+  /// "mmsi = <mmsi>" on topic `id` (whose type has an `mmsi` member). Writers that filter on
+  /// their side (Fast DDS does, up to their writer_resource_limits.reader_filters_allocation
+  /// readers) then do not send other vessels' samples to this reader at all; the others are
+  /// filtered on arrival, before the listener.
+  eprosima::fastdds::dds::DataReader& create_vessel_reader(
+      TopicId id, const std::string& profile, std::uint32_t mmsi,
+      eprosima::fastdds::dds::DataReaderListener* listener = nullptr,
+      const eprosima::fastdds::dds::StatusMask& mask = eprosima::fastdds::dds::StatusMask::all());
+
   /// Typed shorthands: the topic follows from the data type.
   template <class T>
   eprosima::fastdds::dds::DataWriter& create_writer(const std::string& profile) {

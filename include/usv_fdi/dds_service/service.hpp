@@ -21,6 +21,10 @@ struct ServiceConfig {
   usvfdi::dds::DdsConfig dds;
   std::uint32_t mmsi = 0;        ///< the vessel this sidecar watches (required, > 0)
   bool reliable_inputs = false;  ///< INS and rudder readers RELIABLE instead of BEST_EFFORT
+  /// INS, rudder and ack readers on content-filtered topics "mmsi = <mmsi>": writers that filter
+  /// on their side send them nothing of other vessels (false: every sample of the partition
+  /// arrives and other vessels' are dropped after their receipt).
+  bool content_filter = true;
   std::string log_level = "info";
   std::string config_file;  ///< where it was loaded from (for messages)
   /// Directory of the state journal (latched faults survive a restart); "" : none.
@@ -34,7 +38,7 @@ struct ServiceConfig {
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
 ///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
 ///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
-///   reliable_inputs, estimate_wait [s], status_rate [Hz], log_level, authorised_operators: [..],
+///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level, authorised_operators: [..],
 ///   input_queue, rudder_wait, rudder_timeout, input_timeout, restore_recheck,
 ///   state_dir (relative to the config file; "" : no persistence), health_file.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
