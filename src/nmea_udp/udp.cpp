@@ -25,6 +25,8 @@ constexpr std::size_t kMaxExamples = 8;
 /// Read buffer: larger than any UDP payload, so that an over-long datagram is seen whole (and
 /// refused as too long) rather than cut.
 constexpr std::size_t kReadBuffer = 65536;
+/// Datagrams read by one poll() at most.
+constexpr int kMaxPerPoll = 256;
 
 in_addr to_in_addr(const std::string& address) {
   in_addr a{};
@@ -227,7 +229,8 @@ int NmeaUdpReceiver::poll(int timeout_ms) {
   if (ready < 0) return errno == EINTR ? 0 : -1;
   if (ready == 0) return 0;
   int n = 0;
-  while (true) {
+  // Bounded, so that a flood cannot keep the caller from handing samples on or stopping.
+  while (n < kMaxPerPoll) {
     const ssize_t got = ::recv(fd_, buffer_.data(), buffer_.size(), 0);
     if (got < 0) {
       if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) return n;
@@ -238,6 +241,7 @@ int NmeaUdpReceiver::poll(int timeout_ms) {
     decoder_.add(std::string_view(buffer_.data(), static_cast<std::size_t>(got)), now);
     ++n;
   }
+  return n;
 }
 
 NmeaUdpSender::NmeaUdpSender(const Endpoint& to, const std::string& interface_address, int ttl) {

@@ -111,8 +111,9 @@ class NmeaUdpReceiver {
   NmeaUdpReceiver(const NmeaUdpReceiver&) = delete;
   NmeaUdpReceiver& operator=(const NmeaUdpReceiver&) = delete;
 
-  /// Waits up to timeout_ms for a datagram (poll), then reads every datagram waiting into the
-  /// decoder. Returns the datagrams read; -1 on a socket error (errno kept; EINTR is 0).
+  /// Waits up to timeout_ms for a datagram (poll), then reads the datagrams waiting (at most
+  /// 256) into the decoder. Returns the datagrams read; -1 on a socket error (errno kept; EINTR is
+  /// 0).
   int poll(int timeout_ms);
   DatagramDecoder& decoder() { return decoder_; }
   const DatagramDecoder& decoder() const { return decoder_; }
