@@ -3,9 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <set>
+#include <sstream>
+#include <thread>
 
 #include <fstream>
 #include <iostream>
@@ -24,6 +27,8 @@
 #include "usv_fdi/io/nmea_log.hpp"
 #include "usv_fdi/io/output_file.hpp"
 #include "usv_fdi/io/scenarios.hpp"
+#include "usv_fdi/nmea/datagram.hpp"
+#include "usv_fdi/nmea_udp/udp.hpp"
 #include "usv_fdi/sim/voyage.hpp"
 #ifdef USV_FDI_APP_WITH_DDS
 #include "dds_options.hpp"
@@ -44,6 +49,10 @@ struct SimArgs : VoyageCommon {
   }
   std::string steering;  ///< empty: the scenario's
   VoyageArgs voyage;     ///< options of the voyage scenarios (sim_voyage.cpp)
+  double speed = 1.0;    ///< --publish, --udp: data time per wall time
+  std::string udp;       ///< --nmea --udp GROUP:PORT: send IEC 61162-450 datagrams there
+  std::string udp_interface = "127.0.0.1";  ///< IP_MULTICAST_IF
+  int udp_ttl = 1;                          ///< IP_MULTICAST_TTL
 #ifdef USV_FDI_APP_WITH_DDS
   bool publish = false;
   std::vector<std::uint32_t> mmsi;
@@ -80,6 +89,10 @@ bool is_classic(const std::string& scenario) {
 
 /// A voyage scenario: the voyage simulator over any hull (sim_voyage.cpp).
 int run_voyage_scenario(const SimArgs& a) {
+  if (!a.udp.empty()) {
+    spdlog::error("--udp sends the classic scenarios (paper, healthy, faults) only");
+    return kExitUsage;
+  }
   if (!a.steering.empty()) {
     spdlog::error("--steering applies to the classic scenarios (paper, healthy, faults) only");
     return kExitUsage;
@@ -240,10 +253,60 @@ int publish_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig
     return kExitConfig;
   }
   PublishOptions opt = a.pub;
+  opt.speed = a.speed;
   opt.reliable = a.pub.reliable || config_reliable;
   return publish_simulation(vessels, dds, opt);
 }
 #endif
+
+/// --nmea --udp GROUP:PORT: the classic scenario as IEC 61162-450 datagrams, one per sample
+/// ("UdPbC\0", then ROT, RSA, VBW (and HDT) each after its TAG block with s:, n: and c:),
+/// paced at --speed times real time. The receiver's time is the TAG c:, never the arrival.
+int send_classic_udp(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
+  std::unique_ptr<Simulator> sim;
+  std::unique_ptr<nmea_udp::NmeaUdpSender> sender;
+  nmea_udp::Endpoint to;
+  try {
+    sim = std::make_unique<Simulator>(c);
+    to = nmea_udp::parse_endpoint(a.udp);
+    sender = std::make_unique<nmea_udp::NmeaUdpSender>(to, a.udp_interface, a.udp_ttl);
+  } catch (const std::invalid_argument& e) {
+    spdlog::error("{}", e.what());
+    return kExitUsage;
+  } catch (const std::runtime_error& e) {
+    spdlog::error("{}", e.what());
+    return kExitFailure;
+  }
+  std::ostringstream lines;
+  io::NmeaOutputOptions o;
+  o.b2 = vessel.B(1);
+  o.surge_speed = vessel.u0;
+  o.heading = a.nmea_heading;
+  io::NmeaSimWriter writer(lines, o);
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  SimRow row;
+  std::size_t rows = 0, refused = 0;
+  const bool sent = write_rows(
+      [&] {
+        if (!sim->next(&row)) return false;
+        lines.str("");
+        writer.write(row);
+        std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(
+                                               std::chrono::duration<double>(row.t / a.speed)));
+        if (!sender->send(std::string(nmea::kIec450Header) + lines.str())) ++refused;
+        return true;
+      },
+      &rows);
+  if (!sent) return kExitFailure;
+  spdlog::info(
+      "sent {} samples as IEC 61162-450 datagrams (ROT, RSA, VBW with TAG times) to {}:{} "
+      "(interface {}, TTL {}), vessel {}, scenario {}, {} Hz, {} s at {:g}x real time{}",
+      rows, to.address, to.port, a.udp_interface.empty() ? "default" : a.udp_interface, a.udp_ttl,
+      vessel.name, a.scenario, c.rate_hz, c.duration, a.speed,
+      refused > 0 ? "; " + std::to_string(refused) + " refused by the system" : std::string());
+  return refused > 0 ? kExitFailure : kExitOk;
+}
 
 /// The classic scenario into the --output CSV or NMEA log (a temporary file renamed at the end).
 int write_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig& c) {
@@ -306,8 +369,13 @@ int run_sim(const SimArgs& a) {
 #ifdef USV_FDI_APP_WITH_DDS
   if (a.publish) return publish_classic(a, vessel, c, targeted);
 #endif
-  if (a.output.empty()) {
-    spdlog::error("sim: give --output FILE (or --publish)");
+  if (!a.udp.empty()) {
+    if (!a.nmea || !a.output.empty()) {
+      spdlog::error("sim: --udp goes with --nmea and without --output");
+      return kExitUsage;
+    }
+  } else if (a.output.empty()) {
+    spdlog::error("sim: give --output FILE (or --publish, or --nmea --udp GROUP:PORT)");
     return kExitUsage;
   }
 #ifdef USV_FDI_APP_WITH_DDS
@@ -321,7 +389,7 @@ int run_sim(const SimArgs& a) {
     return kExitUsage;
   }
 #endif
-  return write_classic(a, vessel, c);
+  return a.udp.empty() ? write_classic(a, vessel, c) : send_classic_udp(a, vessel, c);
 }
 
 /// --vessel, --scenario, --rate, --duration, --seed, --fault.
@@ -371,10 +439,6 @@ void add_publish_options(CLI::App* sub, SimArgs* args) {
                   "--publish: this vessel gets neither the scenario's faults nor the --fault "
                   "specs without MMSI@ (repeatable)")
       ->check(CLI::Range(1u, 999999999u));
-  sub->add_option("--speed", args->pub.speed,
-                  "--publish: data time per wall time (1 real time, 20 twenty times faster)")
-      ->check(CLI::Range(0.01, 10000.0))
-      ->capture_default_str();
   sub->add_flag("--reliable", args->pub.reliable,
                 "--publish: RELIABLE INS and rudder writers (they match best-effort and "
                 "reliable sidecars; a sidecar with reliable_inputs: true needs them)");
@@ -412,6 +476,23 @@ void register_sim_command(CommandRegistry& registry) {
                 "bow to starboard), $VDVBW (v and the vessel's nominal u, kn, 4 decimals), each "
                 "after a TAG block with c: = 2026-01-01T00:00:00Z + t (ms)");
   sub->add_flag("--nmea-heading", args->nmea_heading, "--nmea: also $HEHDT (psi, deg)");
+  sub->add_option("--udp", args->udp,
+                  "--nmea: send the samples as IEC 61162-450 datagrams (one per sample, TAG "
+                  "times) to this multicast group or unicast address, ADDRESS:PORT (e.g. "
+                  "239.192.0.1:60001), paced by --speed, instead of writing --output");
+  sub->add_option("--udp-interface", args->udp_interface,
+                  "--udp: the multicast interface's address (IP_MULTICAST_IF; '' : the "
+                  "system's choice)")
+      ->capture_default_str();
+  sub->add_option("--udp-ttl", args->udp_ttl,
+                  "--udp: multicast TTL (0: this host only, 1: the local network)")
+      ->check(CLI::Range(0, 255))
+      ->capture_default_str();
+  sub->add_option("--speed", args->speed,
+                  "--publish, --udp: data time per wall time (1 real time, 20 twenty times "
+                  "faster)")
+      ->check(CLI::Range(0.01, 10000.0))
+      ->capture_default_str();
   sub->add_option("--steering", args->steering, "autopilot or sine (default: the scenario's)")
       ->check(CLI::IsMember({"autopilot", "sine"}));
   sub->add_option("--noise-scale", args->noise_scale,

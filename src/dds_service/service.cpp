@@ -194,6 +194,11 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
   };
   auto on_status = [this, mmsi, iso](const pipeline::PipelineStatus& s) {
     fdi::FdiStatus d = to_dds(s, mmsi, iso);
+    if (nmea_) {
+      // The input's own words first: which sentence stopped, lines lost or refused.
+      const std::string note = nmea_->status_note();
+      if (!note.empty()) d.message((note + d.message().to_string()).substr(0, 127).c_str());
+    }
     if (watch_) {
       if (watch_->recent(std::chrono::seconds(10))) {
         d.input_flags(d.input_flags() | pipeline::kInputOtherEventWriter);
@@ -225,19 +230,21 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     return cfg_.content_filter ? ctx.create_vessel_reader(id, profile, mmsi)
                                : ctx.create_reader(id, profile);
   };
-  DataReader& ins = reader(*dds_, dds::TopicId::kIns,
-                           cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
-                                                : dds::profiles::kInsReaderBestEffort);
-  DataReader& rudder = reader(*dds_, dds::TopicId::kRudder,
-                              cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
-                                                   : dds::profiles::kRudderReaderBestEffort);
+  if (cfg_.input == InputSource::kNmea) {
+    nmea_ = std::make_unique<NmeaInput>(cfg_.nmea, pipeline_.get(), log_);
+  } else {
+    listener_->ins_ = &reader(*dds_, dds::TopicId::kIns,
+                              cfg_.reliable_inputs ? dds::profiles::kInsReaderReliable
+                                                   : dds::profiles::kInsReaderBestEffort);
+    listener_->rudder_ = &reader(*dds_, dds::TopicId::kRudder,
+                                 cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
+                                                      : dds::profiles::kRudderReaderBestEffort);
+  }
   // Acks are read by a participant of their own: its traffic arrives on its own port, handled
   // by its own receive thread, so a flood of acks cannot hold up (nor, through KEEP_LAST
   // histories, lose) the INS and rudder samples behind it.
   ack_dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
   DataReader& ack = reader(*ack_dds_, dds::TopicId::kFaultAck, dds::profiles::kFaultAckReader);
-  listener_->ins_ = &ins;
-  listener_->rudder_ = &rudder;
   listener_->ack_ = &ack;
   watch_ = std::make_unique<EventWatch>(mmsi, event_writer_->get_instance_handle(), log_);
   event_watch_ = &dds_->create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader);
@@ -376,9 +383,11 @@ FdiService::Matches FdiService::matches() const {
   if (stopped_ || !dds_) return m;
   eprosima::fastdds::dds::SubscriptionMatchedStatus sub;
   eprosima::fastdds::dds::PublicationMatchedStatus pub;
-  if (listener_->ins_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
+  if (listener_->ins_ != nullptr &&
+      listener_->ins_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.ins_writers = sub.current_count;
-  if (listener_->rudder_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
+  if (listener_->rudder_ != nullptr &&
+      listener_->rudder_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.rudder_writers = sub.current_count;
   if (listener_->ack_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.ack_writers = sub.current_count;
@@ -408,9 +417,19 @@ void FdiService::start() {
   pipeline_->start();
   // Listeners are attached only now, so nothing arrives before the threads run.
   for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_}) {
-    r->set_listener(listener_.get(), StatusMask::data_available());
+    if (r != nullptr) r->set_listener(listener_.get(), StatusMask::data_available());
   }
   event_watch_->set_listener(watch_.get(), StatusMask::data_available());
+  if (nmea_) {
+    nmea_->start();
+    if (log_) {
+      char rate[96];
+      std::snprintf(rate, sizeof rate, "samples at %g Hz, max age %g s",
+                    cfg_.nmea.assembler.rate_hz, cfg_.nmea.assembler.max_age_s);
+      log_(1, "NMEA input: " + nmea_->describe() + " (receive buffer " +
+                  std::to_string(nmea_->receive_buffer()) + " bytes), " + rate);
+    }
+  }
 }
 
 void FdiService::stop() {
@@ -419,7 +438,8 @@ void FdiService::stop() {
   for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_, event_watch_}) {
     if (r != nullptr) r->set_listener(nullptr);
   }
-  pipeline_->stop();  // drains the queues; the publisher thread writes the last events
+  if (nmea_) nmea_->stop();  // no more samples; its status note stays readable
+  pipeline_->stop();         // drains the queues; the publisher thread writes the last events
   ack_dds_.reset();
   dds_.reset();  // delete_contained_entities(), then the participant
 }

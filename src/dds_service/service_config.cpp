@@ -16,6 +16,7 @@
 
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
+#include "usv_fdi/nmea/navigation.hpp"
 
 #ifndef USV_FDI_DEFAULT_QOS_PROFILES
 #define USV_FDI_DEFAULT_QOS_PROFILES ""
@@ -169,6 +170,55 @@ void add_process_keys(ServiceLoad* s, ConfigValue::Table* table) {
   };
 }
 
+/// service.input and service.nmea: the live NMEA 0183 / IEC 61162-450 input over UDP.
+void add_input_keys(ServiceLoad* s, ConfigValue::Table* table) {
+  ServiceConfig& cfg = s->cfg;
+  ConfigValue::Table& t = *table;
+  t["input"] = [&cfg](const ConfigValue& v) {
+    const std::string in = v.text("dds or nmea");
+    if (in == "dds") {
+      cfg.input = InputSource::kDds;
+    } else if (in == "nmea") {
+      cfg.input = InputSource::kNmea;
+    } else {
+      v.fail("must be dds (InsSample and RudderSample topics) or nmea (NMEA 0183 over UDP)");
+    }
+  };
+  t["nmea"] = [&cfg](const ConfigValue& v) {
+    if (v.is_null()) v.fail("must be a mapping (address, port, interface, rate, ...)");
+    nmea_udp::ReceiverConfig& n = cfg.nmea;
+    const auto address = [](const ConfigValue& a, bool empty_ok) {
+      const std::string text = a.is_null() ? std::string() : a.text("an IPv4 address");
+      if (text.empty() && empty_ok) return text;
+      try {
+        nmea_udp::is_multicast(text);
+      } catch (const std::invalid_argument& e) {
+        a.fail(e.what());
+      }
+      return text;
+    };
+    ConfigValue::Table keys;
+    keys["address"] = [&n, address](const ConfigValue& a) {
+      n.endpoint.address = address(a, false);
+    };
+    keys["port"] = [&n](const ConfigValue& a) {
+      n.endpoint.port = static_cast<std::uint16_t>(a.integer(1, 65535, "a UDP port (1..65535)"));
+    };
+    keys["interface"] = [&n, address](const ConfigValue& a) {
+      n.interface_address = address(a, true);
+    };
+    keys["rate"] = [&n](const ConfigValue& a) {
+      n.assembler.rate_hz = a.number(1e-3, 1e4, "a rate in Hz", "0.001 to 10000 Hz");
+    };
+    keys["max_age"] = positive_time(&n.assembler.max_age_s);
+    keys["receive_buffer"] = [&n](const ConfigValue& a) {
+      n.receive_buffer =
+          static_cast<int>(a.integer(0, 1 << 30, "a size in bytes", "0..1073741824 bytes"));
+    };
+    v.section(keys);
+  };
+}
+
 /// A silent INS is reported as stale faults: the silence must outlast the stale check.
 void check_input_timeout(const ServiceLoad& s) {
   if (s.input_timeout_at.empty() ||
@@ -221,12 +271,14 @@ ServiceConfig load_service_config(const std::string& path) {
   add_dds_keys(&s, &service);
   add_pipeline_keys(&s, &service);
   add_process_keys(&s, &service);
+  add_input_keys(&s, &service);
   // One reading of the file: the engine's keys and, by these handlers, the service section.
   s.cfg.engine = io::load_engine_config(
       path, {{"service", [&service](const ConfigValue& v) { v.section(service); }}});
   check_input_timeout(s);
   check_distinct_topics(s);
   s.cfg.dds.profiles_file = s.qos;
+  s.cfg.nmea.assembler.rudder_sign = nmea::rudder_sign_from_b2(s.cfg.engine.B(1));
   return std::move(s.cfg);
 }
 

@@ -178,8 +178,7 @@ void NmeaSampleReader::read_line(const std::string& raw) {
   }
 
   const std::string& f = s.formatter;
-  const bool input = !s.proprietary && (f == "ROT" || f == "RSA" || f == "VBW" || f == "VTG");
-  if (!input) {
+  if (!nmea::SampleAssembler::is_input(s)) {
     if (tag_t) last_tag_t_ = tag_t;
     ++stats_.ignored;
     return;
@@ -189,40 +188,24 @@ void NmeaSampleReader::read_line(const std::string& raw) {
     count("no time", "no TAG block with c: before it and no sentence rate (--nmea-rate)");
     return;
   }
-  // Parse here (not add_sentence) to tell a status V from a valid value.
-  bool valid = false;
-  bool added = false;
-  nmea::Rejection why;
-  const auto feed = [&](const auto& parsed, auto is_valid) {
-    if (!parsed) {
-      why = parsed.rejection();
+  const nmea::InputResult r = assembler_->add_sentence(*t, s);
+  switch (r.use) {
+    case nmea::InputUse::kRefused:
+      count(nmea::to_string(r.rejection.reason), f + ": " + r.rejection.text);
       return;
-    }
-    valid = is_valid(parsed.value());
-    added = assembler_->add(*t, parsed.value());
-  };
-  if (f == "ROT") {
-    feed(nmea::parse_rot(s), [](const nmea::Rot& x) { return x.valid(); });
-  } else if (f == "RSA") {
-    feed(nmea::parse_rsa(s),
-         [](const nmea::Rsa& x) { return x.starboard_valid() || x.port_valid(); });
-  } else if (f == "VBW") {
-    feed(nmea::parse_vbw(s),
-         [](const nmea::Vbw& x) { return x.water_valid() && x.water_transverse_kn.has_value(); });
-  } else {
-    feed(nmea::parse_vtg(s),
-         [](const nmea::Vtg& x) { return x.valid() && x.speed_kn.has_value(); });
+    case nmea::InputUse::kOutOfOrder:
+      count("time going back", f + ": t = " + std::to_string(*t) + " before the latest line's");
+      return;
+    case nmea::InputUse::kNotValid:
+      count("status V", f + ": its status says the data are not valid (or the value is empty)");
+      break;
+    case nmea::InputUse::kUsed:
+      ++stats_.used;
+      break;
+    case nmea::InputUse::kNotAnInput:  // is_input said it is one
+      return;
   }
-  if (!why.text.empty()) {
-    count(nmea::to_string(why.reason), f + ": " + why.text);
-  } else if (!added) {
-    count("time going back", f + ": t = " + std::to_string(*t) + " before the latest line's");
-  } else if (!valid) {
-    count("status V", f + ": its status says the data are not valid (or the value is empty)");
-  } else {
-    ++stats_.used;
-  }
-  if (added) latest_t_ = *t;
+  latest_t_ = *t;
 }
 
 NmeaSimWriter::NmeaSimWriter(std::ostream& out, const NmeaOutputOptions& options)

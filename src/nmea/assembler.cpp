@@ -84,21 +84,34 @@ bool SampleAssembler::add(double t, const Vtg& vtg) {
 
 namespace {
 
+// Whether a sentence carries a valid value of the quantity it is read for (kUsed), or says
+// that quantity is not valid (kNotValid). Mirrors what add() holds.
+bool carries_value(const Rot& x) { return x.valid(); }
+bool carries_value(const Rsa& x) { return x.starboard_valid() || x.port_valid(); }
+bool carries_value(const Vbw& x) { return x.water_valid() && x.water_transverse_kn.has_value(); }
+bool carries_value(const Vtg& x) { return x.valid() && x.speed_kn.has_value(); }
+
 template <class T>
 InputResult feed(SampleAssembler* a, double t, const Result<T>& parsed) {
   if (!parsed) return InputResult{InputUse::kRefused, parsed.rejection()};
   if (!a->add(t, parsed.value())) return InputResult{InputUse::kOutOfOrder, {}};
-  return InputResult{InputUse::kUsed, {}};
+  return InputResult{carries_value(parsed.value()) ? InputUse::kUsed : InputUse::kNotValid, {}};
 }
 
 }  // namespace
 
+bool SampleAssembler::is_input(const Sentence& s) {
+  if (s.proprietary) return false;
+  const std::string& f = s.formatter;
+  return f == "ROT" || f == "RSA" || f == "VBW" || f == "VTG";
+}
+
 InputResult SampleAssembler::add_sentence(double t, const Sentence& s) {
-  if (!s.proprietary) {
+  if (is_input(s)) {
     if (s.formatter == "ROT") return feed(this, t, parse_rot(s));
     if (s.formatter == "RSA") return feed(this, t, parse_rsa(s));
     if (s.formatter == "VBW") return feed(this, t, parse_vbw(s));
-    if (s.formatter == "VTG") return feed(this, t, parse_vtg(s));
+    return feed(this, t, parse_vtg(s));
   }
   return InputResult{InputUse::kNotAnInput, {}};
 }

@@ -229,6 +229,15 @@ TEST(Assembler, AddSentenceDispatchesAndReports) {
   EXPECT_EQ(refused.use, InputUse::kRefused);
   EXPECT_EQ(refused.rejection.reason, Reason::kOutOfRange);
   EXPECT_EQ(a.add_sentence(-1.0, test::sentence("HEROT,1,A")).use, InputUse::kOutOfOrder);
+  // Read, but its status says the value is not valid (or the value fed is empty): kNotValid
+  SampleAssembler b(AssemblerConfig{});
+  EXPECT_EQ(b.add_sentence(0.0, test::sentence("HEROT,-12.4,V")).use, InputUse::kNotValid);
+  EXPECT_EQ(b.add_sentence(0.0, test::sentence("AGRSA,5.2,V,,V")).use, InputUse::kNotValid);
+  EXPECT_EQ(b.add_sentence(0.0, test::sentence("IIVBW,7.5,-0.3,V,7.6,-0.2,A")).use,
+            InputUse::kNotValid);
+  EXPECT_EQ(b.add_sentence(0.0, test::sentence("IIVBW,7.5,,A,,,V")).use, InputUse::kNotValid);
+  EXPECT_EQ(b.add_sentence(0.0, test::sentence("GPVTG,70.5,T,,M,10.2,N,18.9,K,N")).use,
+            InputUse::kNotValid);
   a.advance(0.0);
   const auto s = a.take();
   ASSERT_EQ(s.size(), 1u);

@@ -159,5 +159,57 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
   std::remove(p2.c_str());
 }
 
+TEST(ServiceConfig, NmeaInputKeys) {
+  // GIVEN the default (DDS inputs) and a config with every key of the NMEA input
+  const ServiceConfig d = load_service_config(kSource + "/config/service/example.yaml");
+  EXPECT_EQ(d.input, InputSource::kDds);
+  EXPECT_EQ(d.nmea.endpoint.address, "239.192.0.1");
+  EXPECT_EQ(d.nmea.endpoint.port, 60001);
+  const std::string path = write_temp("nmea", R"(model:
+  B: [0.1, 2.0]
+service:
+  input: nmea
+  nmea:
+    address: 239.192.0.4
+    port: 60004
+    interface: 127.0.0.1
+    rate: 20
+    max_age: 0.5
+    receive_buffer: 65536
+)");
+  // THEN each is applied, and the rudder sign follows model.B (b2 > 0: RSA's sign)
+  const ServiceConfig c = load_service_config(path);
+  EXPECT_EQ(c.input, InputSource::kNmea);
+  EXPECT_EQ(c.nmea.endpoint.address, "239.192.0.4");
+  EXPECT_EQ(c.nmea.endpoint.port, 60004);
+  EXPECT_EQ(c.nmea.interface_address, "127.0.0.1");
+  EXPECT_DOUBLE_EQ(c.nmea.assembler.rate_hz, 20.0);
+  EXPECT_DOUBLE_EQ(c.nmea.assembler.max_age_s, 0.5);
+  EXPECT_EQ(c.nmea.receive_buffer, 65536);
+  EXPECT_EQ(c.nmea.assembler.rudder_sign, nmea::RudderSign::kPositiveToStarboard);
+  EXPECT_EQ(d.nmea.assembler.rudder_sign, nmea::RudderSign::kPositiveToPort);  // b2 < 0
+  std::remove(path.c_str());
+  // AND mistakes name the file, line and key
+  const std::pair<std::string, std::string> cases[] = {
+      {"  input: serial", "4: service.input = serial: must be dds"},
+      {"  nmea:\n    address: vessel", "5: service.nmea.address = vessel: "},
+      {"  nmea:\n    port: 70000", "5: service.nmea.port = 70000: must be a UDP port"},
+      {"  nmea:\n    rate: 0", "5: service.nmea.rate = 0: must be 0.001 to 10000 Hz"},
+      {"  nmea:\n    group: 239.192.0.1", "5: service.nmea.group = group: unknown key"},
+  };
+  for (const auto& [service, expect] : cases) {
+    const std::string bad =
+        write_temp("bad", "model:\n  B: [0.1, -2.0]\nservice:\n" + service + "\n");
+    try {
+      load_service_config(bad);
+      ADD_FAILURE() << "accepted: " << service;
+    } catch (const io::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad + ":" + expect), std::string::npos)
+          << e.what() << "\n  expected: " << expect;
+    }
+    std::remove(bad.c_str());
+  }
+}
+
 }  // namespace
 }  // namespace usvfdi::dds_service

@@ -11,9 +11,17 @@
 #include "usv_fdi/core/engine.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 #include "usv_fdi/dds_service/journal.hpp"
+#include "usv_fdi/dds_service/nmea_input.hpp"
+#include "usv_fdi/nmea_udp/udp.hpp"
 #include "usv_fdi/pipeline/pipeline.hpp"
 
 namespace usvfdi::dds_service {
+
+/// Where the sidecar's INS and rudder samples come from (service.input).
+enum class InputSource {
+  kDds,   ///< InsSample / RudderSample topics (the default)
+  kNmea,  ///< NMEA 0183 / IEC 61162-450 over UDP (service.nmea; nmea_udp/udp.hpp)
+};
 
 struct ServiceConfig {
   EngineConfig engine;
@@ -33,6 +41,10 @@ struct ServiceConfig {
   /// true: set by service.state_dir or --state-dir (created if missing; "" disables).
   bool state_dir_explicit = false;
   std::string health_file;  ///< service.health_file / --health-file ("" : none)
+  InputSource input = InputSource::kDds;
+  /// service.nmea (input: nmea): the socket and the sample assembler; the rudder sign is
+  /// model.B's (nmea::rudder_sign_from_b2).
+  nmea_udp::ReceiverConfig nmea;
 };
 
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
@@ -40,7 +52,8 @@ struct ServiceConfig {
 ///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
 ///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level, authorised_operators: [..],
 ///   input_queue, rudder_wait, rudder_timeout, input_timeout, restore_recheck,
-///   state_dir (relative to the config file; "" : no persistence), health_file.
+///   state_dir (relative to the config file; "" : no persistence), health_file,
+///   input (dds | nmea), nmea: {address, port, interface, rate, max_age, receive_buffer}.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
 /// Throws usvfdi::io::ConfigError naming file, key, line and value.
 ServiceConfig load_service_config(const std::string& path);
@@ -100,6 +113,8 @@ class FdiService {
   /// with the same MMSI, or a forger), and the samples they wrote.
   std::uint64_t other_event_writers() const;
   std::uint64_t other_event_samples() const;
+  /// The live NMEA input (input: nmea), else nullptr.
+  const NmeaInput* nmea_input() const { return nmea_.get(); }
 
  private:
   class Listener;
@@ -113,6 +128,7 @@ class FdiService {
   std::string journal_error_logged_;  ///< publisher thread: the save error already logged
   std::unique_ptr<pipeline::FdiPipeline> pipeline_;
   std::unique_ptr<Listener> listener_;
+  std::unique_ptr<NmeaInput> nmea_;  ///< input: nmea (the INS and rudder readers are not made)
   std::unique_ptr<EventWatch> watch_;
   int lock_fd_ = -1;  ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
   std::unique_ptr<usvfdi::dds::DdsContext> dds_;

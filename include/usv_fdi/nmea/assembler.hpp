@@ -58,7 +58,11 @@ struct AssembledSample {
 
 /// What SampleAssembler::add_sentence did with a sentence.
 enum class InputUse {
-  kUsed,        ///< ROT, RSA, VBW or VTG, read and held
+  kUsed,  ///< ROT, RSA, VBW or VTG with a valid value, read and held
+  /// ROT, RSA, VBW or VTG read, but its status says the data are not valid (V, a VTG mode
+  /// N/E/M/S) or the value it feeds is empty: that quantity is invalidated from now on. A VBW
+  /// is valid when its transverse water speed (v) is; an RSA when either rudder is.
+  kNotValid,
   kNotAnInput,  ///< another sentence formatter (HDT, THS, ALF, ...): nothing to do
   kRefused,     ///< its typed parser refused it (see the rejection)
   kOutOfOrder,  ///< its time is not finite or earlier than the latest input's
@@ -90,8 +94,13 @@ class SampleAssembler {
   bool add(double t, const Vbw& vbw);
   bool add(double t, const Vtg& vtg);
 
-  /// Parses a sentence of any formatter and adds it when it is one of the inputs.
+  /// Parses a sentence of any formatter and adds it when it is one of the inputs. The one
+  /// place that dispatches on the formatter and judges validity: the log reader
+  /// (io::NmeaSampleReader) and the live UDP input both call it.
   InputResult add_sentence(double t, const Sentence& s);
+
+  /// True for the sentences add_sentence reads (ROT, RSA, VBW, VTG; not proprietary).
+  static bool is_input(const Sentence& s);
 
   /// Emits the samples of every grid time <= t (time passing without input).
   void advance(double t);

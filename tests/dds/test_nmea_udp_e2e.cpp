@@ -1,0 +1,328 @@
+// End-to-end tests of the live NMEA input (issue 12, section 2): the real `usv-fdi` executable
+// as sidecar (`run` with service.input: nmea), as NMEA sender (`sim --nmea --udp`) and as shore
+// monitor (`monitor`), each in its own process. The sentences travel as IEC 61162-450 datagrams
+// over UDP multicast on the loopback interface (group 239.192.0.1, joined on 127.0.0.1, a port
+// private to the test); FaultEvent and FdiStatus still go over Fast DDS (UDPv4 on 127.0.0.1, a
+// private domain and partition). Every wait is bounded; the times asserted are source (TAG)
+// times, never wall-clock limits.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fleet.hpp"
+#include "support.hpp"  // tests/nmea: sentences with checksums
+#include "usv_fdi/nmea/datagram.hpp"
+#include "usv_fdi/nmea_udp/udp.hpp"
+
+namespace usvfdi::dds::test {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+
+constexpr const char* kGroup = "239.192.0.1";
+
+/// A UDP port private to this test process and test (ctest -j runs several at once).
+unsigned test_port(unsigned index) {
+  return 20000u + (static_cast<unsigned>(::getpid()) % 10000u) * 4u + index;
+}
+
+/// The service lines of a sidecar reading NMEA on group:port (loopback). Every sentence comes
+/// at the grid rate with its TAG time on the grid, so max_age is below one grid period: a
+/// lost datagram is a gap in the samples, not the previous value held for one more sample
+/// (held, on the noise-free paper scenario, it delays identification, the gyro bias on 20-40 s
+/// goes unseen and a gyro "noise" fault is raised at 40.7 s; docs/integration.md).
+std::vector<std::string> nmea_service(unsigned port, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> lines = {"input: nmea",
+                                    "nmea:",
+                                    std::string("  address: ") + kGroup,
+                                    "  port: " + std::to_string(port),
+                                    "  interface: 127.0.0.1",
+                                    "  rate: 10",
+                                    "  max_age: 0.05"};
+  lines.insert(lines.end(), extra.begin(), extra.end());
+  return lines;
+}
+
+std::string dump(const std::vector<MonitorEvent>& all) {
+  std::string s;
+  for (const auto& e : all) {
+    s += e.sensor + " #" + std::to_string(e.sequence) + " " + e.state + " " + e.kind +
+         " t=" + std::to_string(e.stamp) + " C_a=" + std::to_string(e.c_a) +
+         " C_g=" + std::to_string(e.c_g) + "\n";
+  }
+  return s;
+}
+
+/// The first event of `sensor` in state `state` stamped in [t0, t1), or nullptr.
+const MonitorEvent* first(const std::vector<MonitorEvent>& all, const std::string& sensor,
+                          const std::string& state, double t0, double t1) {
+  for (const auto& e : all) {
+    if (e.sensor == sensor && e.state == state && e.stamp >= t0 && e.stamp < t1) return &e;
+  }
+  return nullptr;
+}
+
+/// The number after "key": in a JSON line (NaN if absent).
+double number_of(const std::string& line, const std::string& key) {
+  const auto at = line.find("\"" + key + "\":");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(line.c_str() + at + key.size() + 3, nullptr);
+}
+
+TEST(NmeaUdpEndToEnd, PaperScenarioOverMulticastRaisesAndIsolatesBothFaults) {
+  // GIVEN a monitor and a sidecar whose input is NMEA over UDP multicast (loopback)
+  Fleet f;
+  const unsigned m = 257300001;
+  const unsigned port = test_port(0);
+  const std::string cfg = f.write_service_config("svc", m, nmea_service(port));
+  ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
+  f.start_service("svc", cfg, 1);
+  ASSERT_TRUE(f.wait_for_log("svc", "NMEA input: multicast group", seconds(10))) << f.log("svc");
+  // WHEN the simulator sends the paper's scenario (Otter, noise-free, 10 Hz) as IEC 61162-450
+  // datagrams, ten times faster than real time
+  ChildProcess& sim = f.start(
+      "sim",
+      {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10", "--noise-scale", "0",
+       "--nmea", "--udp", std::string(kGroup) + ":" + std::to_string(port), "--speed", "10"},
+      {}, false);
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  const bool complete = read_monitor_until(
+      monitor, &ev, &st, seconds(60),
+      [&](const std::vector<MonitorEvent>& e) {
+        return first(e, "gyro", "cleared", 40.0, 100.0) != nullptr &&
+               first(e, "accelerometer", "cleared", 80.0, 100.0) != nullptr;
+      },
+      &err);
+  ASSERT_TRUE(complete) << err << "\n" << dump(ev) << f.log("svc") << f.log("sim");
+  const auto sim_exit = sim.wait_exit(seconds(30));
+  ASSERT_TRUE(sim_exit.has_value());
+  EXPECT_EQ(*sim_exit, 0) << f.log("sim");
+
+  // THEN each fault was raised within 3 s of its onset (TAG time, t = 0 at the first
+  // datagram), isolated to its sensor, and cleared after its end
+  const MonitorEvent* gyro = first(ev, "gyro", "raised", 0.0, 100.0);
+  ASSERT_NE(gyro, nullptr) << dump(ev);
+  EXPECT_GE(gyro->stamp, 20.0) << dump(ev);
+  EXPECT_LE(gyro->stamp, 23.0) << dump(ev);
+  EXPECT_GE(gyro->c_g, 0.8) << dump(ev);
+  EXPECT_LE(gyro->c_a, 0.2) << dump(ev);
+  const MonitorEvent* acc = first(ev, "accelerometer", "raised", 0.0, 100.0);
+  ASSERT_NE(acc, nullptr) << dump(ev);
+  EXPECT_GE(acc->stamp, 60.0) << dump(ev);
+  EXPECT_LE(acc->stamp, 63.0) << dump(ev);
+  EXPECT_GE(acc->c_a, 0.8) << dump(ev);
+  EXPECT_LE(acc->c_g, 0.2) << dump(ev);
+  // AND no other fault was raised during the voyage (a lost datagram is a gap, not a fault)
+  for (const auto& e : ev) {
+    if (e.stamp >= 100.0 || e.state != "raised") continue;
+    EXPECT_TRUE((e.sensor == "gyro" && e.stamp >= 20.0 && e.stamp < 40.0) ||
+                (e.sensor == "accelerometer" && e.stamp >= 60.0 && e.stamp < 80.0))
+        << dump(ev);
+  }
+  // AND the status saw the voyage's samples (100 s at 10 Hz) and a converged, armed detector
+  unsigned long long most = 0;
+  bool armed = false;
+  const auto until = std::chrono::steady_clock::now() + seconds(20);
+  while (most < 1000u && std::chrono::steady_clock::now() < until) {
+    for (const auto& s : st) {
+      most = std::max(most, s.samples);
+      armed |= s.armed;
+    }
+    if (const auto line = monitor.read_line(milliseconds(500))) {
+      parse_monitor_line(*line, &ev, &st, &err);
+    }
+  }
+  EXPECT_GE(most, 1000u);
+  EXPECT_TRUE(armed);
+  // AND the live input raised what the log replay of the same voyage raises, at the same
+  // (TAG) times with the same isolation: one code path (SampleAssembler::add_sentence), and
+  // times that do not depend on when the datagrams arrived
+  const std::string log_file = f.dir() + "paper.nmea";
+  const std::string out = f.dir() + "replay.jsonl";
+  ASSERT_EQ(f.run_to_end("simlog",
+                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
+                          "--noise-scale", "0", "--nmea", "--output", log_file},
+                         seconds(60), nullptr, false),
+            0);
+  ASSERT_EQ(f.run_to_end("replay",
+                         {"replay", "--config",
+                          std::string(USV_FDI_SOURCE_DIR) + "/config/scenarios/paper.yaml",
+                          "--input", log_file, "--output", out},
+                         seconds(120), nullptr, false),
+            0)
+      << f.log("replay");
+  std::ifstream in(out);
+  int compared = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("\"type\":\"event\"") == std::string::npos ||
+        line.find("\"state\":\"raised\"") == std::string::npos) {
+      continue;
+    }
+    const bool is_gyro = line.find("\"sensor\":\"gyro\"") != std::string::npos;
+    const MonitorEvent* live = is_gyro ? gyro : acc;
+    EXPECT_DOUBLE_EQ(number_of(line, "detection_time"), live->detection_time) << line;
+    EXPECT_DOUBLE_EQ(number_of(line, "c_a"), live->c_a) << line;
+    EXPECT_DOUBLE_EQ(number_of(line, "c_g"), live->c_g) << line;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 2) << "the replay raised " << compared << " faults";
+  // AND the sidecar stops on SIGTERM
+  ChildProcess& svc = f.process("svc");
+  svc.signal(SIGTERM);
+  const auto code = svc.wait_exit(seconds(10));
+  ASSERT_TRUE(code.has_value()) << f.log("svc");
+  EXPECT_EQ(*code, 0) << f.log("svc");
+}
+
+/// "\s:HE0001,n:N,c:MS*hh\$BODY*hh\r\n"
+std::string tagged(const std::string& body, std::int64_t n, std::int64_t ms) {
+  nmea::TagBlock tag;
+  tag.source = "HE0001";
+  tag.line_count = (n - 1) % 999 + 1;
+  tag.unix_time_ms = ms;
+  return nmea::format_tag_block(tag).value() + nmea::test::with_checksum(body) + "\r\n";
+}
+
+TEST(NmeaUdpEndToEnd, StoppedRsaSentenceIsReportedAsRudderStaleInFdiStatus) {
+  // GIVEN a sidecar reading NMEA over UDP multicast and a monitor of its status
+  Fleet f;
+  const unsigned m = 257300002;
+  const unsigned port = test_port(1);
+  const std::string cfg =
+      f.write_service_config("svc", m, nmea_service(port, {"rudder_wait: 0.1"}));
+  ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
+  f.start_service("svc", cfg, 1);
+  ASSERT_TRUE(f.wait_for_log("svc", "NMEA input: multicast group", seconds(10))) << f.log("svc");
+  // WHEN ROT, RSA and VBW arrive at 10 Hz (TAG time) for 3 s, then ROT and VBW without RSA
+  // (sent 5 times faster than real time) until the status says so
+  nmea_udp::NmeaUdpSender tx(nmea_udp::Endpoint{kGroup, static_cast<std::uint16_t>(port)},
+                             "127.0.0.1", 0);
+  const std::int64_t epoch = 1767225600000;
+  std::int64_t n = 0;
+  bool reported = false;
+  std::string status_line, last_status;
+  const auto deadline = std::chrono::steady_clock::now() + seconds(60);
+  for (int k = 0; !reported && std::chrono::steady_clock::now() < deadline; ++k) {
+    const std::int64_t ms = epoch + 100 * k;
+    std::string lines =
+        tagged("HEROT,6.000,A", n + 1, ms) + tagged("VDVBW,1.9438,0.0100,A,,,V", n + 2, ms);
+    n += 2;
+    if (k < 30) lines += tagged("AGRSA,2.000,A,,V", ++n, ms);
+    ASSERT_TRUE(tx.send(std::string(nmea::kIec450Header) + lines));
+    std::this_thread::sleep_for(milliseconds(10));
+    // The monitor's status lines so far (a short read: the sender goes on meanwhile)
+    while (auto line = monitor.read_line(milliseconds(10))) {
+      if (line->find("\"type\":\"status\"") == std::string::npos) continue;
+      std::vector<MonitorEvent> ev;
+      std::vector<MonitorStatus> st;
+      std::string err;
+      last_status = *line;
+      if (!parse_monitor_line(*line, &ev, &st, &err) || st.empty()) continue;
+      if (st.back().has_flag("rudder_missing") &&
+          line->find("NMEA RSA stale") != std::string::npos) {
+        reported = true;
+        status_line = *line;
+        break;
+      }
+    }
+  }
+  // THEN FdiStatus flags the rudder input missing and its message names the RSA sentence
+  ASSERT_TRUE(reported) << "last status: " << last_status << "\n" << f.log("svc");
+  EXPECT_NE(status_line.find("(delta)"), std::string::npos) << status_line;
+  EXPECT_EQ(status_line.find("NMEA ROT stale"), std::string::npos) << status_line;
+  EXPECT_EQ(status_line.find("NMEA VBW stale"), std::string::npos) << status_line;
+  // AND the sidecar logged that RSA stopped
+  EXPECT_TRUE(f.wait_for_log("svc", "NMEA input: RSA (delta) has stopped", seconds(5)))
+      << f.log("svc");
+}
+
+TEST(NmeaUdpEndToEnd, LostDatagramsAreCountedAndInventNoFault) {
+  // GIVEN the paper's scenario as the simulator's NMEA log (ROT, RSA, VBW per sample, TAG
+  // times and line counts), a sidecar reading NMEA over UDP multicast, and a monitor
+  Fleet f;
+  const unsigned m = 257300003;
+  const unsigned port = test_port(2);
+  const std::string log_file = f.dir() + "paper.nmea";
+  ASSERT_EQ(f.run_to_end("simlog",
+                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
+                          "--noise-scale", "0", "--nmea", "--output", log_file},
+                         seconds(60), nullptr, false),
+            0);
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(log_file);
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (!line.empty()) lines.push_back(line + "\r\n");
+    }
+  }
+  ASSERT_EQ(lines.size(), 3u * 1001u);
+  const std::string cfg = f.write_service_config("svc", m, nmea_service(port));
+  ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
+  f.start_service("svc", cfg, 1);
+  ASSERT_TRUE(f.wait_for_log("svc", "NMEA input: multicast group", seconds(10))) << f.log("svc");
+  // WHEN the samples are sent as IEC 61162-450 datagrams (10 times faster than real time) but
+  // every 37th datagram is lost on the way
+  nmea_udp::NmeaUdpSender tx(nmea_udp::Endpoint{kGroup, static_cast<std::uint16_t>(port)},
+                             "127.0.0.1", 0);
+  unsigned lost = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t k = 0; k < 1001; ++k) {
+    std::this_thread::sleep_until(t0 + milliseconds(10 * k));
+    if (k % 37 == 36) {
+      ++lost;
+      continue;
+    }
+    ASSERT_TRUE(tx.send(std::string(nmea::kIec450Header) + lines[3 * k] + lines[3 * k + 1] +
+                        lines[3 * k + 2]));
+  }
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err, lost_status;
+  const auto deadline = std::chrono::steady_clock::now() + seconds(30);
+  while (lost_status.empty() && std::chrono::steady_clock::now() < deadline) {
+    const auto line = monitor.read_line(milliseconds(500));
+    if (!line) continue;
+    ASSERT_TRUE(parse_monitor_line(*line, &ev, &st, &err)) << err;
+    if (line->find("\"type\":\"status\"") != std::string::npos &&
+        line->find("NMEA " + std::to_string(3 * lost) + " lines lost") != std::string::npos) {
+      lost_status = *line;
+    }
+  }
+  // THEN FdiStatus counts the lost lines (3 per datagram) ...
+  EXPECT_FALSE(lost_status.empty()) << "no status with " << 3 * lost << " lines lost\n"
+                                    << f.log("svc");
+  // ... both faults were still raised and isolated to their sensors, and nothing else was
+  // raised during the voyage: a lost datagram is a gap in the data, never a fault
+  const MonitorEvent* gyro = first(ev, "gyro", "raised", 0.0, 100.0);
+  const MonitorEvent* acc = first(ev, "accelerometer", "raised", 0.0, 100.0);
+  ASSERT_NE(gyro, nullptr) << dump(ev) << f.log("svc");
+  ASSERT_NE(acc, nullptr) << dump(ev) << f.log("svc");
+  EXPECT_GE(gyro->stamp, 20.0) << dump(ev);
+  EXPECT_LE(gyro->stamp, 23.0) << dump(ev);
+  EXPECT_GE(gyro->c_g, 0.8) << dump(ev);
+  EXPECT_GE(acc->stamp, 60.0) << dump(ev);
+  EXPECT_LE(acc->stamp, 63.0) << dump(ev);
+  EXPECT_GE(acc->c_a, 0.8) << dump(ev);
+  for (const auto& e : ev) {
+    if (e.stamp >= 100.0 || e.state != "raised") continue;
+    EXPECT_TRUE((e.sensor == "gyro" && e.stamp >= 20.0 && e.stamp < 40.0) ||
+                (e.sensor == "accelerometer" && e.stamp >= 60.0 && e.stamp < 80.0))
+        << dump(ev) << f.log("svc");
+  }
+}
+
+}  // namespace
+}  // namespace usvfdi::dds::test
