@@ -4,14 +4,20 @@
 // With --ack it acknowledges an event and waits for the sidecar's confirmation.
 // It always reads FdiStatus too (printed with --status): every sample of a vessel updates its
 // "last heard" time, and a vessel not heard for --silent-after s is flagged silent on a timer.
+// With --roster it knows the fleet's MMSIs and shows (and reports) a vessel never heard. --once
+// waits for the latched state (LatchedStateWait), not a fixed time. The table redraws in place
+// on a terminal and prints only the changed rows elsewhere (TableOutput).
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,6 +27,7 @@
 #include "dds_options.hpp"
 #include "fleet_view.hpp"
 #include "monitor_format.hpp"
+#include "table_output.hpp"
 #include "usv_fdi/core/text.hpp"
 #include "usv_fdi/io/config.hpp"
 
@@ -29,10 +36,21 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+TableInput table_input(const FleetView& view) {
+  return TableInput{view.rows(), view.vessels(), view.liveness(), view.conflicts(), &view.roster()};
+}
+
 void print_table(const FleetView& view) {
+  TableExtras extras;
+  extras.roster = &view.roster();
   const std::string t = format_table(view.rows(), view.vessels(), view.liveness(), view.conflicts(),
-                                     wall_now(), mono_now());
+                                     wall_now(), mono_now(), extras);
   std::fputs(t.c_str(), stdout);
+  std::fflush(stdout);
+}
+
+void write_stdout(const std::string& text) {
+  std::fputs(text.c_str(), stdout);
   std::fflush(stdout);
 }
 
@@ -171,6 +189,13 @@ bool parse_acks(const MonitorArgs& a, std::vector<AckRequest>* acks) {
 /// Returns kExitOk, or the exit code after logging why not.
 int join_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
                 std::unique_ptr<FleetView>* view, CredentialExpiry* expiry) {
+  std::set<std::uint32_t> roster;
+  std::string why;
+  if (!a.roster.empty() && !load_roster(a.roster, &roster, &why)) {
+    spdlog::error("{}", why);
+    return kExitConfig;
+  }
+  if (!roster.empty()) spdlog::info("roster {}: {} vessel(s)", a.roster, roster.size());
   dds::DdsConfig cfg;
   try {
     cfg = make_dds_config(a.dds);
@@ -180,7 +205,7 @@ int join_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
   }
   try {
     *ctx = std::make_unique<dds::DdsContext>(cfg);
-    *view = std::make_unique<FleetView>(**ctx, a);
+    *view = std::make_unique<FleetView>(**ctx, a, std::move(roster));
   } catch (const std::exception& e) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
@@ -199,26 +224,45 @@ int join_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
   return kExitOk;
 }
 
-/// Receives until --expect instances are known, --duration (--once: 3 s by default) has
-/// passed or a signal came, printing the table on every change unless --json or --once
-/// (*printed: it was printed). Returns kExitOk, or kExitFailure when the credentials expire.
-int watch(const MonitorArgs& a, FleetView& view, const CredentialExpiry& expiry, bool* printed) {
-  const double duration = a.once && a.duration == 0.0 ? 3.0 : a.duration;
+/// Receives until --expect instances are known, --once has the latched state, --duration
+/// (--once: kOnceDefaultDuration by default) has passed or a signal came, showing the table
+/// unless --json or --once (TableOutput). Returns kExitOk, or kExitFailure when the credentials
+/// expire.
+int watch(const MonitorArgs& a, FleetView& view, const CredentialExpiry& expiry) {
+  const double duration = a.once && a.duration == 0.0 ? kOnceDefaultDuration : a.duration;
+  const bool show_table = !a.json && !a.once;
+  TableOutput table(show_table && ::isatty(STDOUT_FILENO) == 1, write_stdout);
   const auto start = Clock::now();
+  bool latched = false;
   for (;;) {
-    const bool changed = view.poll(0.2);
-    if (changed && !a.json && !a.once) {
-      print_table(view);
-      *printed = true;
-    }
+    const double wait = a.once ? 0.05 : std::min(0.2, table.due_in(mono_now()));
+    const bool changed = view.poll(wait);
+    if (show_table) table.update(table_input(view), changed, wall_now(), mono_now());
     if (expiry.expired(wall_now())) {  // Fast DDS would keep the session open
       spdlog::error("{}", expired_message(expiry));
       return kExitFailure;
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     const bool enough = a.expect > 0 && static_cast<int>(view.rows().size()) >= a.expect;
-    if (enough || (duration > 0 && elapsed >= duration) || wait_for_stop_signal(0.0) != 0) break;
+    // --once --expect N: as before, N instances (or --duration) end the wait.
+    latched = a.once && a.expect == 0 && view.latched_complete();
+    if (enough || latched || (duration > 0 && elapsed >= duration) ||
+        wait_for_stop_signal(0.0) != 0) {
+      break;
+    }
   }
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  if (a.once && a.expect == 0) {
+    if (latched) {
+      spdlog::info("latched state received after {:.2f} s", elapsed);
+    } else {
+      std::string what;
+      for (const std::string& p : view.latched_pending()) what += (what.empty() ? "" : "; ") + p;
+      spdlog::warn("the latched state may be incomplete after {:.2f} s (--duration {:g} s): {}",
+                   elapsed, duration, what.empty() ? "interrupted" : what);
+    }
+  }
+  if (show_table) table.finish(table_input(view), wall_now(), mono_now());
   return kExitOk;
 }
 
@@ -237,7 +281,37 @@ void print_once(const MonitorArgs& a, const FleetView& view) {
       std::printf("%s\n", json_status(v, view.heard_age(m), wall_now()).c_str());
     });
   }
+  const RosterWatch& roster = view.roster();
+  if (roster.active()) {
+    for (const std::uint32_t m : roster.shown(view.liveness())) {
+      std::printf("%s\n",
+                  json_roster(m, roster.state(m, view.liveness()), view.heard_age(m)).c_str());
+    }
+  }
   std::fflush(stdout);
+}
+
+/// With a roster: warns about every roster vessel never heard (and silent), and returns
+/// kExitIncomplete with --once if one was never heard.
+int report_roster(const MonitorArgs& a, const FleetView& view) {
+  const RosterWatch& roster = view.roster();
+  if (!roster.active()) return kExitOk;
+  const std::vector<std::uint32_t> missing = roster.never_heard(view.liveness());
+  for (const std::uint32_t m : missing) {
+    spdlog::warn("roster vessel {} was never heard", m);
+  }
+  for (const std::uint32_t m : roster.roster()) {
+    if (roster.state(m, view.liveness()) == RosterState::kSilent) {
+      spdlog::warn("roster vessel {} is silent: last heard {:.1f} s ago", m, view.heard_age(m));
+    }
+  }
+  if (missing.empty()) {
+    spdlog::info("every vessel of the roster ({}) heard", roster.roster().size());
+    return kExitOk;
+  }
+  spdlog::warn("{} of {} roster vessel(s) never heard: this view of the fleet is partial",
+               missing.size(), roster.roster().size());
+  return a.once ? kExitIncomplete : kExitOk;
 }
 
 int run_monitor(const MonitorArgs& a) {
@@ -255,19 +329,14 @@ int run_monitor(const MonitorArgs& a) {
     rc = send_acks(*ctx, *view, a, acks);
     if (rc != kExitOk || !keep_watching) return rc;
   }
-  bool printed = false;
-  rc = watch(a, *view, expiry, &printed);
+  rc = watch(a, *view, expiry);
   if (rc != kExitOk) return rc;
-  if (a.once) {
-    print_once(a, *view);
-  } else if (!a.json && !printed) {
-    print_table(*view);
-  }
+  if (a.once) print_once(a, *view);
   if (a.expect > 0 && static_cast<int>(view->rows().size()) < a.expect) {
     spdlog::error("saw {} fault instances, expected {}", view->rows().size(), a.expect);
     return kExitFailure;
   }
-  return kExitOk;
+  return report_roster(a, *view);
 }
 
 }  // namespace
@@ -297,10 +366,13 @@ void register_monitor_command(CommandRegistry& registry) {
                   "--ack: wait this long for a sidecar's acknowledgement reader [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  sub->add_option("--duration", args.duration, "stop after this many seconds (0: on a signal)")
+  sub->add_option("--duration", args.duration,
+                  "stop after this many seconds (0: on a signal; --once: the longest wait for "
+                  "the latched state, default 10 s)")
       ->check(CLI::NonNegativeNumber);
   sub->add_flag("--once", args.once,
-                "wait --duration (default 3 s) for the latched state, print it once, exit");
+                "wait until the latched state has arrived (discovery settled, every sidecar's "
+                "status received; at most --duration), print it once, exit");
   sub->add_option("--expect", args.expect, "exit 0 once this many fault instances are known")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--silent-after", args.silent_after,
@@ -309,6 +381,11 @@ void register_monitor_command(CommandRegistry& registry) {
                   "heard again")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  sub->add_option("--roster", args.roster,
+                  "file of the fleet's MMSIs (one per line, '#' comments): a roster vessel never "
+                  "heard is shown and reported (--once: exit 6), a vessel heard that is not on "
+                  "it is marked")
+      ->check(CLI::ExistingFile);
 }
 
 }  // namespace usvfdi::app

@@ -15,12 +15,13 @@ namespace usvfdi::app {
 /// Process exit codes shared by every subcommand.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,   ///< anything else (internal error, bad option value)
-  kExitConfig = 2,    ///< configuration file missing or invalid
-  kExitInput = 3,     ///< input data file missing or malformed
-  kExitOutput = 4,    ///< output file cannot be written
-  kExitRejected = 5,  ///< replay: the input was read, but most rows were rejected
-  kExitUsage = 64,    ///< command line not understood (EX_USAGE)
+  kExitFailure = 1,     ///< anything else (internal error, bad option value)
+  kExitConfig = 2,      ///< configuration file missing or invalid
+  kExitInput = 3,       ///< input data file missing or malformed
+  kExitOutput = 4,      ///< output file cannot be written
+  kExitRejected = 5,    ///< replay: the input was read, but most rows were rejected
+  kExitIncomplete = 6,  ///< monitor --once --roster: a vessel of the roster was never heard
+  kExitUsage = 64,      ///< command line not understood (EX_USAGE)
 };
 
 class CommandRegistry {

@@ -17,9 +17,12 @@
 #include <cstdio>
 #include <sstream>
 
+#include "discovery_limit.hpp"
 #include "instance_owners.hpp"
+#include "latched_wait.hpp"
 #include "monitor_format.hpp"
 #include "monitor_model.hpp"
+#include "roster.hpp"
 #include "usv_fdi/dds/dds_context.hpp"
 #include "usv_fdi/dds_service/convert.hpp"
 #include "vessel_liveness.hpp"
@@ -29,9 +32,10 @@ namespace usvfdi::app {
 namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
 
-/// Records the writers (sidecars) that went away: Fast DDS 2.9 neither delivers an
+/// Records the writers (sidecars) that matched and went away: Fast DDS 2.9 neither delivers an
 /// instance-state sample when a writer disappears nor implements get_matched_publications(),
-/// so the monitor learns it from on_subscription_matched. Only copies a handle under a lock.
+/// so the monitor learns it from on_subscription_matched. Only copies a handle and reads the
+/// monotonic clock under a lock.
 class GoneWriters : public fdds::DataReaderListener {
  public:
   void on_subscription_matched(fdds::DataReader*,
@@ -41,21 +45,35 @@ class GoneWriters : public fdds::DataReaderListener {
       gone_.push_back(info.last_publication_handle);
     } else if (info.current_count_change > 0) {
       back_.push_back(info.last_publication_handle);
+      back_at_.push_back(mono_now());
     }
   }
-  /// Moves the handles of writers gone (and come back) since the last call into the outputs.
-  void take(std::vector<fdds::InstanceHandle_t>* gone, std::vector<fdds::InstanceHandle_t>* back) {
+  /// Moves the handles of writers gone (and matched, with when) since the last call into the
+  /// outputs.
+  void take(std::vector<fdds::InstanceHandle_t>* gone, std::vector<fdds::InstanceHandle_t>* back,
+            std::vector<double>* back_at) {
     std::lock_guard<std::mutex> lock(m_);
     gone->swap(gone_);
     back->swap(back_);
+    back_at->swap(back_at_);
     gone_.clear();
     back_.clear();
+    back_at_.clear();
   }
 
  private:
   std::mutex m_;
   std::vector<fdds::InstanceHandle_t> gone_, back_;
+  std::vector<double> back_at_;  ///< when each of back_ matched [mono s]
 };
+
+/// How many participants the participant QoS in use can discover at most: with unicast-only
+/// discovery over UDPv4 (initial peers, no builtin transports) a participant announces itself
+/// to the ports of participant ids 0..maxInitialPeersRange-1 of each initial peer, and two
+/// participants whose ports lie beyond that never find each other (also bounded by
+/// mutation_tries, the number of ports a participant tries when its own is taken). 0: no such
+/// limit (multicast discovery, shared memory, discovery servers).
+int unicast_discovery_limit(const fdds::DomainParticipantQos& qos);
 
 /// The text naming a writer in a conflict report: its GUID, its identity's CN and its partitions.
 std::string writer_name(const dds::DdsContext& ctx, const fdds::InstanceHandle_t& h);
@@ -65,12 +83,15 @@ std::string writer_name(const dds::DdsContext& ctx, const fdds::InstanceHandle_t
 /// passes InstanceOwners: only the writer that owns an instance updates it.
 class FleetView {
  public:
-  FleetView(dds::DdsContext& ctx, const MonitorArgs& a)
+  /// `roster`: the MMSIs expected (empty: no roster).
+  FleetView(dds::DdsContext& ctx, const MonitorArgs& a, std::set<std::uint32_t> roster = {})
       : ctx_(ctx),
         a_(a),
         secure_(ctx.secure()),
         filter_(a.mmsi.begin(), a.mmsi.end()),
-        live_(a.silent_after) {
+        live_(a.silent_after),
+        roster_(std::move(roster), mono_now(), a.silent_after),
+        discovery_limit_(unicast_discovery_limit(ctx.participant().get_qos())) {
     events_ = &ctx.create_reader(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventReader,
                                  &events_gone_, fdds::StatusMask::subscription_matched());
     events_->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
@@ -98,6 +119,7 @@ class FleetView {
     fdds::ConditionSeq active;
     ws_.wait(active, eprosima::fastrtps::Duration_t(timeout));
     bool changed = mark_gone_writers();
+    check_discovery_limit();
     fdi::FaultEvent d;
     fdds::SampleInfo info;
     while (events_->take_next_sample(&d, &info) == ReturnCode_t::RETCODE_OK) {
@@ -137,6 +159,7 @@ class FleetView {
     {
       fdi::FdiStatus st;
       while (status_->take_next_sample(&st, &info) == ReturnCode_t::RETCODE_OK) {
+        if (info.valid_data) latched_.status_sample(writer_id(info.publication_handle));
         if (!info.valid_data) {
           const auto it = status_handles_.find(info.instance_handle);
           VesselStatus* v = it == status_handles_.end() ? nullptr : vessels_.shown(it->second);
@@ -168,8 +191,22 @@ class FleetView {
       emit_change(c);
       changed = true;
     }
+    for (const RosterWatch::Change& c : roster_.evaluate(live_, mono_now())) {
+      emit_roster(c);
+      changed = true;
+    }
     return changed;
   }
+
+  /// --once: true when the latched state has arrived (LatchedStateWait).
+  bool latched_complete() const {
+    return latched_.complete(mono_now(), roster_.active(), roster_.never_heard(live_));
+  }
+  /// What the latched state still waits for (empty: nothing).
+  std::vector<std::string> latched_pending() const {
+    return latched_.pending(mono_now(), roster_.active(), roster_.never_heard(live_));
+  }
+  const RosterWatch& roster() const { return roster_; }
 
   int matched_writers() const {
     fdds::SubscriptionMatchedStatus st;
@@ -240,9 +277,14 @@ class FleetView {
   bool mark_gone_writers() {
     bool changed = false;
     std::vector<fdds::InstanceHandle_t> gone, back;
-    events_gone_.take(&gone, &back);
-    for (const auto& h : back) rows_.writer_back(writer_id(h));
+    std::vector<double> back_at;
+    events_gone_.take(&gone, &back, &back_at);
+    for (std::size_t i = 0; i < back.size(); ++i) {
+      rows_.writer_back(writer_id(back[i]));
+      latched_.matched(LatchedStateWait::Topic::kFaultEvent, writer_id(back[i]), back_at[i]);
+    }
     for (const auto& h : gone) {
+      latched_.unmatched(LatchedStateWait::Topic::kFaultEvent, writer_id(h));
       for (const auto& [key, next] : rows_.writer_gone(writer_id(h))) {
         Row* r = rows_.shown(key);
         if (r == nullptr) continue;
@@ -259,9 +301,13 @@ class FleetView {
         if (a_.json) emit_json(*r);
       }
     }
-    status_gone_.take(&gone, &back);
-    for (const auto& h : back) vessels_.writer_back(writer_id(h));
+    status_gone_.take(&gone, &back, &back_at);
+    for (std::size_t i = 0; i < back.size(); ++i) {
+      vessels_.writer_back(writer_id(back[i]));
+      latched_.matched(LatchedStateWait::Topic::kStatus, writer_id(back[i]), back_at[i]);
+    }
     for (const auto& h : gone) {
+      latched_.unmatched(LatchedStateWait::Topic::kStatus, writer_id(h));
       for (const auto& [m, next] : vessels_.writer_gone(writer_id(h))) {
         VesselStatus* v = vessels_.shown(m);
         if (v == nullptr) continue;
@@ -280,8 +326,48 @@ class FleetView {
     return true;
   }
 
+  /// Warns once when the participants discovered approach the limit of unicast discovery of
+  /// the participant profile in use (unicast_discovery_limit()).
+  void check_discovery_limit() {
+    if (discovery_limit_ <= 0) return;
+    const std::size_t n = ctx_.peers().participant_count() + 1;  // this monitor included
+    const int level = discovery_limit_level(n, discovery_limit_);
+    if (level <= discovery_warned_) return;
+    discovery_warned_ = level;
+    spdlog::warn(
+        "discovery: {} participants on domain {} (this monitor included) {} the {} the "
+        "participant profile '{}' can discover by unicast (its UDPv4 transport's "
+        "maxInitialPeersRange, at most its mutation_tries): participants beyond it may never "
+        "be discovered and their "
+        "vessels would be missing from this view{}; raise maxInitialPeersRange, or use "
+        "multicast discovery or a discovery server",
+        n, ctx_.config().domain_id, level >= 2 ? "have reached" : "approach", discovery_limit_,
+        ctx_.config().participant_profile,
+        roster_.active() ? "" : " (give the fleet's MMSIs with --roster to be told which)");
+  }
+
+  /// Reports a change against the roster once: a warning on stderr, a line (or a "roster" object
+  /// with --json) on stdout; with --once only the final state is printed.
+  void emit_roster(const RosterWatch::Change& c) const {
+    if (a_.once) return;
+    const std::string line = roster_line(c);
+    if (c.state == RosterState::kHeard) {
+      spdlog::info("{}", line);
+    } else {
+      spdlog::warn("{}", line);
+    }
+    const std::string out =
+        a_.json ? json_roster(c.mmsi, roster_.state(c.mmsi, live_), live_.age(c.mmsi, mono_now()))
+                : line;
+    std::printf("%s\n", out.c_str());
+    std::fflush(stdout);
+  }
+
   /// Prints a vessel's change of silence once (not with --once: it prints the final state).
   void emit_change(const VesselLiveness::Change& c) const {
+    if (c.silent && roster_.on_roster(c.mmsi)) {
+      spdlog::warn("roster vessel {} silent: nothing heard for {:.1f} s", c.mmsi, c.age);
+    }
     if (a_.once) return;
     const std::string line =
         a_.json ? json_change(c, live_.silent_after()) : change_line(c, live_.silent_after());
@@ -308,6 +394,10 @@ class FleetView {
   InstanceOwners<std::uint32_t, VesselStatus> vessels_;
   std::map<fdds::InstanceHandle_t, std::uint32_t> status_handles_;
   VesselLiveness live_;
+  RosterWatch roster_;
+  LatchedStateWait latched_;
+  int discovery_limit_ = 0;   ///< unicast_discovery_limit() of the participant QoS (0: none)
+  int discovery_warned_ = 0;  ///< discovery_limit_level() already warned about
   int conflicts_ = 0;
 };
 

@@ -116,48 +116,100 @@ std::string json_conflict(const OwnerDecision& d, std::uint32_t mmsi, const char
   return os.str();
 }
 
+std::string roster_line(const RosterWatch::Change& c) {
+  char buf[200];
+  switch (c.state) {
+    case RosterState::kNeverHeard:
+      std::snprintf(buf, sizeof buf, "vessel %u (on roster): never heard (%.1f s since start)",
+                    c.mmsi, c.waited);
+      break;
+    case RosterState::kHeard:
+      std::snprintf(buf, sizeof buf, "vessel %u (on roster): heard, %.1f s after start", c.mmsi,
+                    c.waited);
+      break;
+    default:
+      std::snprintf(buf, sizeof buf, "vessel %u heard: not on roster", c.mmsi);
+      break;
+  }
+  return buf;
+}
+
+std::string json_roster(std::uint32_t mmsi, RosterState state, double heard_age) {
+  std::ostringstream os;
+  os << "{\"type\":\"roster\",\"mmsi\":" << mmsi << ",\"state\":\"" << to_string(state)
+     << "\",\"on_roster\":" << (state == RosterState::kNotOnRoster ? "false" : "true")
+     << ",\"heard\":" << (state == RosterState::kNeverHeard ? "false" : "true")
+     << ",\"heard_age_s\":" << io::json_number(heard_age) << "}";
+  return os.str();
+}
+
+std::string fault_row_line(const Row& r, double now) {
+  std::string state = to_string(r.ev.state);
+  if (!r.alive) state += "?";  // the sidecar is gone: last known state
+  char buf[1024];
+  std::snprintf(buf, sizeof buf, "%-10u %-13s %-21s %-8s %5.2f %5.2f %4llu %8.2f %8.2f %7.1f  %s",
+                r.mmsi, to_string(r.ev.sensor), state.c_str(), to_string(r.ev.kind), r.ev.c_a,
+                r.ev.c_g, static_cast<unsigned long long>(r.ev.sequence), r.ev.onset_time, r.ev.t,
+                now - r.written, escape_text(r.ev.message).c_str());
+  return buf;
+}
+
 std::string format_table(const InstanceOwners<RowKey, Row>& rows,
                          const InstanceOwners<std::uint32_t, VesselStatus>* vessels,
-                         const VesselLiveness& live, int conflicts, double now, double mono) {
+                         const VesselLiveness& live, int conflicts, double now, double mono,
+                         const TableExtras& extras) {
   std::string out;
   const auto printf = [&out](const char* fmt, auto... args) {
     char buf[1024];
     std::snprintf(buf, sizeof buf, fmt, args...);
     out += buf;
   };
-  printf("%-10s %-13s %-21s %-8s %5s %5s %4s %8s %8s %7s  %s\n", "VESSEL", "SENSOR", "STATE",
-         "KIND", "C_A", "C_G", "SEQ", "ONSET[s]", "T[s]", "AGE[s]", "MESSAGE");
+  const char* mark_blank = extras.marked != nullptr ? "  " : "";
+  printf("%s%-10s %-13s %-21s %-8s %5s %5s %4s %8s %8s %7s  %s\n", mark_blank, "VESSEL", "SENSOR",
+         "STATE", "KIND", "C_A", "C_G", "SEQ", "ONSET[s]", "T[s]", "AGE[s]", "MESSAGE");
   bool any_gone = false;
   std::set<std::uint32_t> gone_vessels;
-  rows.for_each([&](const RowKey&, const Row& r) {
-    std::string state = to_string(r.ev.state);
+  rows.for_each([&](const RowKey& key, const Row& r) {
     if (!r.alive) {
-      state += "?";  // the sidecar is gone: last known state
       any_gone = true;
       gone_vessels.insert(r.mmsi);
     }
-    printf("%-10u %-13s %-21s %-8s %5.2f %5.2f %4llu %8.2f %8.2f %7.1f  %s\n", r.mmsi,
-           to_string(r.ev.sensor), state.c_str(), to_string(r.ev.kind), r.ev.c_a, r.ev.c_g,
-           static_cast<unsigned long long>(r.ev.sequence), r.ev.onset_time, r.ev.t, now - r.written,
-           escape_text(r.ev.message).c_str());
+    const char* mark = extras.marked == nullptr ? "" : extras.marked->count(key) > 0 ? "* " : "  ";
+    printf("%s%s\n", mark, fault_row_line(r, now).c_str());
   });
-  printf("(%zu fault instances%s)\n", rows.size(),
-         any_gone ? "; '?': sidecar gone, last known state" : "");
+  printf("(%zu fault instances%s%s)\n", rows.size(),
+         any_gone ? "; '?': sidecar gone, last known state" : "",
+         extras.marked != nullptr ? "; '*': changed in the last seconds" : "");
   if (conflicts > 0) {
     printf("!! %d conflicting writer(s) refused or held: see the log (CONFLICT ...)\n", conflicts);
   }
-  // One line per vessel heard: how long ago; with --status also its FdiStatus.
-  for (const std::uint32_t mmsi : live.vessels()) {
+  const RosterWatch* roster =
+      extras.roster != nullptr && extras.roster->active() ? extras.roster : nullptr;
+  if (roster != nullptr) {
+    const std::vector<std::uint32_t> missing = roster->never_heard(live);
+    if (!missing.empty()) {
+      printf("!! %zu of %zu roster vessel(s) never heard\n", missing.size(),
+             roster->roster().size());
+    }
+  }
+  // One line per vessel heard or on the roster: how long ago; with --status also its FdiStatus.
+  for (const std::uint32_t mmsi : roster != nullptr ? roster->shown(live) : live.vessels()) {
+    const RosterState rs = roster != nullptr ? roster->state(mmsi, live) : RosterState::kNoRoster;
+    if (rs == RosterState::kNeverHeard) {
+      printf("vessel %u (on roster): never heard\n", mmsi);
+      continue;
+    }
+    const char* tag = rs == RosterState::kNotOnRoster ? " (not on roster)" : "";
     const VesselStatus* vs = vessels != nullptr ? vessels->shown(mmsi) : nullptr;
     if (vs == nullptr) {
-      printf("%s\n", heard_line(mmsi, live, gone_vessels.count(mmsi) > 0, mono).c_str());
+      printf("%s%s\n", heard_line(mmsi, live, gone_vessels.count(mmsi) > 0, mono).c_str(), tag);
       continue;
     }
     const fdi::FdiStatus& s = vs->st;
     printf(
-        "%s; t=%.1f s, %s%s, A=[%.4g %.4g; %.4g %.4g], %llu samples, %llu "
+        "%s%s; t=%.1f s, %s%s, A=[%.4g %.4g; %.4g %.4g], %llu samples, %llu "
         "dropped: %s\n",
-        heard_line(mmsi, live, !vs->alive, mono).c_str(), s.stamp(),
+        heard_line(mmsi, live, !vs->alive, mono).c_str(), tag, s.stamp(),
         s.converged() ? "converged" : "identifying", s.armed() ? ", armed" : "", s.a()[0], s.a()[1],
         s.a()[2], s.a()[3], static_cast<unsigned long long>(s.samples()),
         static_cast<unsigned long long>(s.dropped()), escape_text(s.message().to_string()).c_str());

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <set>
 #include <string>
 
 #include "instance_owners.hpp"
 #include "monitor_model.hpp"
+#include "roster.hpp"
 #include "vessel_liveness.hpp"
 
 namespace usvfdi::app {
@@ -27,9 +29,28 @@ std::string json_change(const VesselLiveness::Change& c, double silent_after);
 /// {"type":"conflict",...}: a writer other than an instance's owner (see InstanceOwners).
 std::string json_conflict(const OwnerDecision& d, std::uint32_t mmsi, const char* sensor,
                           const std::string& writer, std::uint64_t seq, const std::string& state);
-/// The table: one row per fault instance, a line per vessel heard (with its status if given).
+/// The line printed once when a roster vessel is found never heard, is heard after it was
+/// reported, or a vessel not on the roster is heard.
+std::string roster_line(const RosterWatch::Change& c);
+/// {"type":"roster",...}: a vessel's state against the roster (`heard_age`: NaN if never heard).
+std::string json_roster(std::uint32_t mmsi, RosterState state, double heard_age);
+
+/// One fault instance as a row of the table (without the newline).
+std::string fault_row_line(const Row& r, double now);
+
+/// What the table shows besides the fleet: the roster (its vessels never heard, the vessels
+/// heard that are not on it) and the rows to mark as recently changed ('*' in a first column;
+/// nullptr: no such column).
+struct TableExtras {
+  const RosterWatch* roster = nullptr;
+  const std::set<RowKey>* marked = nullptr;
+};
+
+/// The table: one row per fault instance, a line per vessel heard or on the roster (with its
+/// status if given).
 std::string format_table(const InstanceOwners<RowKey, Row>& rows,
                          const InstanceOwners<std::uint32_t, VesselStatus>* vessels,
-                         const VesselLiveness& live, int conflicts, double now, double mono);
+                         const VesselLiveness& live, int conflicts, double now, double mono,
+                         const TableExtras& extras = {});
 
 }  // namespace usvfdi::app

@@ -24,11 +24,15 @@ struct MonitorArgs {
   std::string operator_id = "operator";
   double ack_timeout = 5.0;         ///< wait for the sidecar's confirmation of an ack [s]
   double discovery_timeout = 10.0;  ///< wait for a sidecar's ack reader [s]
-  double duration = 0.0;            ///< stop after this long (0: until a signal)
-  bool once = false;          ///< print the latched state after --duration (default 3 s) and exit
-  int expect = 0;             ///< stop once this many instances are known
+  double duration = 0.0;            ///< stop after this long (0: until a signal; --once: 10 s)
+  bool once = false;  ///< wait for the latched state (at most --duration), print it and exit
+  int expect = 0;     ///< stop once this many instances are known
   double silent_after = 5.0;  ///< flag a vessel not heard for longer than this [s]
+  std::string roster;         ///< file of the fleet's expected MMSIs ("" : no roster)
 };
+
+/// --once without --duration waits for the latched state at most this long [s].
+constexpr double kOnceDefaultDuration = 10.0;
 
 /// Wall-clock seconds since the epoch (the writer's source timestamps are on this clock).
 inline double wall_now() {

@@ -19,7 +19,12 @@ void PeerDirectory::on_participant_discovery(eprosima::fastdds::dds::DomainParti
   if (info.status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT ||
       info.status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
     subjects_.erase(prefix);
+    participants_.erase(prefix);
     return;
+  }
+  if (info.status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT ||
+      info.status == rtps::ParticipantDiscoveryInfo::CHANGED_QOS_PARTICIPANT) {
+    participants_.insert(prefix);
   }
 #if HAVE_SECURITY
   // The identity token the participant announced; under DDS Security only a participant that
@@ -55,6 +60,11 @@ std::optional<PeerDirectory::Writer> PeerDirectory::writer(
   const auto s = subjects_.find(guid.guidPrefix);
   if (s != subjects_.end()) w.subject = s->second;
   return w;
+}
+
+std::size_t PeerDirectory::participant_count() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return participants_.size();
 }
 
 std::string PeerDirectory::subject_of(const rtps::InstanceHandle_t& publication) const {

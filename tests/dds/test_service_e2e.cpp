@@ -14,7 +14,9 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -243,6 +245,141 @@ TEST(ServiceEndToEnd, LateJoiningMonitorReceivesTheLatchedStateOfEveryInstance) 
   ASSERT_TRUE(code2.has_value());
   EXPECT_EQ(*code2, 0);
   EXPECT_EQ(other, "");
+}
+
+// ------------------------------------------------------------------ monitor --once, roster
+
+/// The seconds the monitor took to receive the latched state, from its log ("latched state
+/// received after X s"); -1 if it did not say.
+double latched_after(const std::string& log) {
+  const std::string key = "latched state received after ";
+  const std::size_t at = log.find(key);
+  return at == std::string::npos ? -1.0 : std::atof(log.c_str() + at + key.size());
+}
+
+TEST(ServiceEndToEnd, MonitorOnceWaitsForTheLatchedStateAndReportsTheRoster) {
+  Fleet f;
+  const unsigned m = 257100006;
+  const unsigned missing = 257100007;
+  // GIVEN a sidecar with gyro #2 cleared-unacknowledged and accelerometer #1 raised
+  run_partial_voyage(f, m);
+  // WHEN a monitor joins with --once (no --expect, no --duration)
+  std::string out;
+  auto code = f.run_to_end("once", {"monitor", "--json", "--once"}, seconds(30), &out);
+  // THEN it prints the latched state of both instances and says it has it
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << f.log("once");
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  {
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);) {
+      ASSERT_TRUE(parse_monitor_line(line, &ev, &st, &err)) << err;
+    }
+  }
+  ASSERT_EQ(of(ev, m, "accelerometer").size(), 1u) << out << f.log("once");
+  EXPECT_EQ(of(ev, m, "accelerometer")[0].state, "raised");
+  ASSERT_EQ(of(ev, m, "gyro").size(), 1u) << out << f.log("once");
+  EXPECT_EQ(of(ev, m, "gyro")[0].state, "cleared");
+  const double took = latched_after(f.log("once"));
+  // (Timing is reported, not asserted: a busy machine takes longer; --duration bounds it.)
+  std::printf("monitor --once: latched state received after %.2f s\n", took);
+  EXPECT_GE(took, 0.0) << f.log("once");
+
+  // AND the table form shows the raised fault
+  std::string table;
+  code = f.run_to_end("once_table", {"monitor", "--once"}, seconds(30), &table);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << f.log("once_table");
+  EXPECT_NE(table.find(std::to_string(m) + "  accelerometer raised "), std::string::npos) << table;
+
+  // WHEN a monitor is given a roster with a vessel that does not exist
+  const std::string roster = f.dir() + "roster.txt";
+  {
+    std::ofstream r(roster);
+    r << "# the test fleet\n" << m << "\n" << missing << "  # never started\n";
+  }
+  out.clear();
+  code =
+      f.run_to_end("roster", {"monitor", "--json", "--once", "--roster", roster, "--duration", "4"},
+                   seconds(30), &out);
+  // THEN it prints the latched state, a roster record per vessel, warns about the missing one
+  // and exits 6
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 6) << f.log("roster");
+  ev.clear();
+  std::map<unsigned, std::string> roster_state;
+  {
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);) {
+      const test_support::MonitorLine l = test_support::parse_monitor_json(line);
+      if (l.type == "fault") ev.push_back(l.fault);
+      if (l.type == "roster") {
+        const auto v = testing_json::Parser(line).parse_document();
+        roster_state[static_cast<unsigned>(v.at("mmsi").num)] = v.at("state").str;
+      }
+    }
+  }
+  EXPECT_EQ(of(ev, m, "accelerometer").size(), 1u) << out;
+  EXPECT_EQ(roster_state[m], "heard") << out;
+  EXPECT_EQ(roster_state[missing], "never_heard") << out;
+  const std::string log = f.log("roster");
+  EXPECT_NE(log.find("roster vessel " + std::to_string(missing) + " was never heard"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("roster vessel " + std::to_string(missing) + " not heard"), std::string::npos)
+      << "the incomplete wait names it\n"
+      << log;
+
+  // AND the table form shows it never heard
+  table.clear();
+  code = f.run_to_end("roster_table", {"monitor", "--once", "--roster", roster, "--duration", "4"},
+                      seconds(30), &table);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 6) << f.log("roster_table");
+  EXPECT_NE(table.find("vessel " + std::to_string(missing) + " (on roster): never heard"),
+            std::string::npos)
+      << table;
+
+  // WHEN the vessel heard is not on the roster THEN it is shown, marked
+  const std::string other = f.dir() + "other.txt";
+  {
+    std::ofstream r(other);
+    r << missing << "\n";
+  }
+  table.clear();
+  code = f.run_to_end("foreign", {"monitor", "--once", "--roster", other, "--duration", "4"},
+                      seconds(30), &table);
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 6) << f.log("foreign");
+  EXPECT_NE(table.find("vessel " + std::to_string(m) + ": last heard"), std::string::npos) << table;
+  EXPECT_NE(table.find("(not on roster)"), std::string::npos) << table;
+  // AND WHEN every roster vessel is heard THEN exit 0
+  const std::string full = f.dir() + "full.txt";
+  {
+    std::ofstream r(full);
+    r << m << "\n";
+  }
+  code = f.run_to_end("full", {"monitor", "--once", "--roster", full}, seconds(30));
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 0) << f.log("full");
+  EXPECT_NE(f.log("full").find("every vessel of the roster (1) heard"), std::string::npos)
+      << f.log("full");
+}
+
+TEST(ServiceCli, MonitorRefusesABadRoster) {
+  Fleet f;
+  const std::string roster = f.dir() + "bad_roster.txt";
+  {
+    std::ofstream r(roster);
+    r << "257000001\nnot-an-mmsi\n";
+  }
+  const auto code = f.run_to_end("bad", {"monitor", "--once", "--roster", roster}, seconds(15));
+  ASSERT_TRUE(code.has_value());
+  EXPECT_EQ(*code, 2) << f.log("bad");
+  EXPECT_NE(f.log("bad").find("bad_roster.txt:2: 'not-an-mmsi' is not an MMSI"), std::string::npos)
+      << f.log("bad");
 }
 
 // ------------------------------------------------------------------ acknowledgements

@@ -12,6 +12,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,8 @@ class PeerDirectory : public eprosima::fastdds::dds::DomainParticipantListener {
 
   /// The remote writer behind a sample's SampleInfo::publication_handle (nullopt: not discovered).
   std::optional<Writer> writer(const eprosima::fastrtps::rtps::InstanceHandle_t& publication) const;
+  /// The remote participants discovered and not removed (or dropped) since.
+  std::size_t participant_count() const;
   /// The subject name of the identity of the participant that owns `publication` ("" : unknown).
   std::string subject_of(const eprosima::fastrtps::rtps::InstanceHandle_t& publication) const;
 
@@ -38,6 +41,7 @@ class PeerDirectory : public eprosima::fastdds::dds::DomainParticipantListener {
  private:
   mutable std::mutex m_;
   std::map<eprosima::fastrtps::rtps::GuidPrefix_t, std::string> subjects_;
+  std::set<eprosima::fastrtps::rtps::GuidPrefix_t> participants_;
   std::map<eprosima::fastrtps::rtps::GUID_t, Writer> writers_;
 };
 
