@@ -13,6 +13,7 @@ void register_run_command(CommandRegistry& registry);      // cmd_run.cpp (DDS s
 void register_monitor_command(CommandRegistry& registry);  // cmd_monitor.cpp (DDS subscriber)
 void register_health_command(CommandRegistry& registry);   // cmd_health.cpp (health check)
 void register_bridge_command(CommandRegistry& registry);   // cmd_bridge.cpp (BAM over 61162-450)
+void register_ros2_command(CommandRegistry& registry);     // cmd_ros2.cpp (ROS 2 via Fast DDS)
 #endif
 
 }  // namespace usvfdi::app

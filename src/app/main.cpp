@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   register_monitor_command(registry);
   register_health_command(registry);
   register_bridge_command(registry);
+  register_ros2_command(registry);
 #endif
 
   try {
