@@ -5,13 +5,16 @@
 //
 //   usv_fdi_ros2_probe publish-paper --profiles FILE --domain N --participant-profile P
 //       [--speed S] [--rudder-sign K] [--imu /imu/data] [--twist /velocity]
-//       [--rudder /rudder_angle] [--timeout SECONDS]
+//       [--rudder /rudder_angle] [--odometry /odom] [--qos default|sensor_data]
+//       [--timeout SECONDS]
 //     The paper's scenario (Otter, 50 Hz, noise-free; gyro bias on [20, 40) s, accelerometer
 //     bias on [60, 80) s) from the simulator, S times faster than real time (default 10), in
 //     REP 103 signs: per sample std_msgs/Float64 rudder (K * δ, default K = 1), then
 //     sensor_msgs/Imu (angular_velocity.z = -r), then geometry_msgs/TwistStamped
-//     (twist.linear.y = -v), stamps t. Waits (up to the timeout, default 20 s) until a reader
-//     matches each writer, prints "publishing", then "published N" and exits 0.
+//     (twist.linear.y = -v), stamps t; with --odometry, nav_msgs/Odometry on that topic
+//     (twist.twist.linear.y = -v) instead of the TwistStamped. --qos sensor_data: writers as
+//     rclcpp's sensor_data profile (BEST_EFFORT, KEEP_LAST 5). Waits (up to the timeout, default 20
+//     s) until a reader matches each writer, prints "publishing", then "published N" and exits 0.
 //
 //   usv_fdi_ros2_probe read-diagnostics --profiles FILE --domain N --participant-profile P
 //     Reads /diagnostics (diagnostic_msgs/DiagnosticArray) and the transient-local mirror
@@ -46,6 +49,7 @@
 
 #include "diagnostic_msgsPubSubTypes.h"
 #include "geometry_msgsPubSubTypes.h"
+#include "nav_msgsPubSubTypes.h"
 #include "probe_common.hpp"
 #include "sensor_msgsPubSubTypes.h"
 #include "std_msgsPubSubTypes.h"
@@ -71,6 +75,8 @@ struct Options {
   double speed = 10.0, timeout = 20.0;
   int rudder_sign = 1;
   std::string imu = "rt/imu/data", twist = "rt/velocity", rudder = "rt/rudder_angle";
+  std::string odometry;  ///< empty: TwistStamped on `twist`
+  bool sensor_data = false;
 };
 
 std::string rt(const std::string& ros) { return "rt/" + (ros[0] == '/' ? ros.substr(1) : ros); }
@@ -101,6 +107,11 @@ Options parse(int argc, char** argv) {
       o.twist = rt(value);
     } else if (flag == "--rudder") {
       o.rudder = rt(value);
+    } else if (flag == "--odometry") {
+      o.odometry = rt(value);
+    } else if (flag == "--qos") {
+      if (value != "default" && value != "sensor_data") throw UsageError("--qos: " + value);
+      o.sensor_data = value == "sensor_data";
     } else {
       throw UsageError("unknown option " + flag);
     }
@@ -134,13 +145,15 @@ class Node {
     if (t == nullptr) throw DdsError("cannot create topic " + name);
     return t;
   }
-  /// rclcpp's default publisher QoS: RELIABLE, VOLATILE, KEEP_LAST 10.
-  fdds::DataWriter* writer(fdds::Topic* t) {
+  /// rclcpp's default publisher QoS: RELIABLE, VOLATILE, KEEP_LAST 10; sensor_data:
+  /// BEST_EFFORT, VOLATILE, KEEP_LAST 5.
+  fdds::DataWriter* writer(fdds::Topic* t, bool sensor_data = false) {
     fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
-    q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+    q.reliability().kind =
+        sensor_data ? fdds::BEST_EFFORT_RELIABILITY_QOS : fdds::RELIABLE_RELIABILITY_QOS;
     q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
     q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-    q.history().depth = 10;
+    q.history().depth = sensor_data ? 5 : 10;
     fdds::DataWriter* w = pub_->create_datawriter(t, q);
     if (w == nullptr) throw DdsError("cannot create a writer of " + t->get_name());
     return w;
@@ -171,12 +184,19 @@ void set_stamp(std_msgs::msg::Header* h, double t) {
 
 int publish_paper(const Options& o) {
   Node n(o);
+  const bool be = o.sensor_data;
   fdds::DataWriter* rudder_w =
-      n.writer(n.topic(o.rudder, fdds::TypeSupport(new std_msgs::msg::Float64PubSubType())));
+      n.writer(n.topic(o.rudder, fdds::TypeSupport(new std_msgs::msg::Float64PubSubType())), be);
   fdds::DataWriter* imu_w =
-      n.writer(n.topic(o.imu, fdds::TypeSupport(new sensor_msgs::msg::ImuPubSubType())));
-  fdds::DataWriter* twist_w = n.writer(
-      n.topic(o.twist, fdds::TypeSupport(new geometry_msgs::msg::TwistStampedPubSubType())));
+      n.writer(n.topic(o.imu, fdds::TypeSupport(new sensor_msgs::msg::ImuPubSubType())), be);
+  fdds::DataWriter* twist_w =
+      o.odometry.empty()
+          ? n.writer(n.topic(o.twist,
+                             fdds::TypeSupport(new geometry_msgs::msg::TwistStampedPubSubType())),
+                     be)
+          : n.writer(
+                n.topic(o.odometry, fdds::TypeSupport(new nav_msgs::msg::OdometryPubSubType())),
+                be);
   const auto deadline = probe::deadline_after(o.timeout);
   for (;;) {
     fdds::PublicationMatchedStatus a, b, c;
@@ -227,7 +247,17 @@ int publish_paper(const Options& o) {
     twist.twist().angular().z(-row.r);
     rudder_w->write(&rudder);
     imu_w->write(&imu);
-    twist_w->write(&twist);
+    if (o.odometry.empty()) {
+      twist_w->write(&twist);
+    } else {
+      nav_msgs::msg::Odometry odom;
+      odom.header(twist.header());
+      odom.header().frame_id("odom");
+      odom.child_frame_id("base_link");
+      odom.pose().pose().orientation().w(1.0);
+      odom.twist().twist(twist.twist());
+      twist_w->write(&odom);
+    }
     ++n_pub;
   }
   rudder_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2.0));

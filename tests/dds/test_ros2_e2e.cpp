@@ -200,5 +200,42 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
   diag.process().signal(SIGTERM);
 }
 
+TEST(Ros2EndToEnd, OdometrySwayFromSensorDataPublishersIsolatesBothFaults) {
+  // GIVEN the adapter reading the sway velocity from nav_msgs/Odometry on /odom, and a ROS 2
+  // node whose writers use the sensor_data profile (BEST_EFFORT), rudder in the sign of model.B
+  Fleet f;
+  const unsigned m = 257100042;
+  const std::string ms = std::to_string(m);
+  const std::string accel = "usv_fdi: " + ms + " accelerometer", gyro = "usv_fdi: " + ms + " gyro";
+  f.start_service("svc", f.write_service_config("svc", m), 0);
+  f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "1", "--reliable", "--sway-type",
+                   "odometry", "--sway-topic", "/odom", "--no-mirrors"});
+  ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
+  Ros2Probe diag(f, "diag", "read-diagnostics", {});
+  Seen seen;
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
+                         [&] { return seen.level(accel) == 0 && seen.level(gyro) == 0; }))
+      << seen.text << f.log("ros2");
+  // WHEN the node publishes the paper's scenario
+  Ros2Probe pub(f, "pub", "publish-paper",
+                {"--speed", "10", "--odometry", "/odom", "--qos", "sensor_data"});
+  // THEN the gyro, then the accelerometer go ERROR, each isolated, and both clear
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(gyro, 2); }))
+      << seen.text << f.log("ros2") << f.log("svc") << f.log("pub");
+  EXPECT_EQ(seen.level(accel), 0) << seen.text;
+  EXPECT_GT(std::stod(seen.last[gyro].values.at("C_g")),
+            std::stod(seen.last[gyro].values.at("C_a")));
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(accel, 2); }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_GT(std::stod(seen.last[accel].values.at("C_a")),
+            std::stod(seen.last[accel].values.at("C_g")));
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90),
+                         [&] { return seen.level(accel) == 1 && seen.level(gyro) == 1; }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_TRUE(seen.mirrors.empty()) << "--no-mirrors\n" << seen.text;
+  ASSERT_TRUE(pub.process().wait_exit(seconds(60)).has_value()) << f.log("pub");
+  diag.process().signal(SIGTERM);
+}
+
 }  // namespace
 }  // namespace usvfdi::dds::test
