@@ -14,6 +14,7 @@ void register_monitor_command(CommandRegistry& registry);  // cmd_monitor.cpp (D
 void register_health_command(CommandRegistry& registry);   // cmd_health.cpp (health check)
 void register_bridge_command(CommandRegistry& registry);   // cmd_bridge.cpp (BAM over 61162-450)
 void register_emulate_command(CommandRegistry& registry);  // cmd_emulate.cpp (fleet emulator)
+void register_ros2_command(CommandRegistry& registry);     // cmd_ros2.cpp (ROS 2 via Fast DDS)
 #endif
 
 }  // namespace usvfdi::app

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   register_health_command(registry);
   register_bridge_command(registry);
   register_emulate_command(registry);
+  register_ros2_command(registry);
 #endif
 
   try {

@@ -1,0 +1,175 @@
+#include "ros2_adapter.hpp"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace usvfdi::app::ros2 {
+
+void to_stamp(double t, std::int32_t* sec, std::uint32_t* nanosec) {
+  double whole = std::floor(t);
+  auto ns = static_cast<std::int64_t>(std::llround((t - whole) * 1e9));
+  if (ns >= 1000000000) {
+    whole += 1.0;
+    ns -= 1000000000;
+  }
+  *sec = static_cast<std::int32_t>(whole);
+  *nanosec = static_cast<std::uint32_t>(ns);
+}
+
+std::string dds_topic_of(const std::string& ros_topic) {
+  std::string name = ros_topic;
+  if (!name.empty() && name.front() == '/') name.erase(0, 1);
+  if (name.empty() || name.back() == '/') return {};
+  bool token_start = true;
+  for (const char c : name) {
+    if (c == '/') {
+      if (token_start) return {};  // "//"
+      token_start = true;
+      continue;
+    }
+    const auto u = static_cast<unsigned char>(c);
+    if (!std::isalnum(u) && c != '_') return {};
+    if (token_start && std::isdigit(u)) return {};
+    token_start = false;
+  }
+  return "rt/" + name;
+}
+
+void InsAssembler::add_sway(double stamp, double v) {
+  if (!std::isfinite(stamp) || !std::isfinite(v) ||
+      (!sway_.empty() && stamp <= sway_.back().first)) {
+    ++sway_rejected_;  // repeated or backward stamps: a second source or a replay
+    return;
+  }
+  sway_.emplace_back(stamp, v);
+  // Keep what a pending INS sample can still use: sway_max_age before the oldest one.
+  const double keep_from =
+      (pending_.empty() ? stamp : std::min(stamp, pending_.front().s.stamp)) - 2 * p_.sway_max_age;
+  while (sway_.size() > 2 && sway_[1].first < keep_from) sway_.pop_front();
+  while (sway_.size() > 4096) sway_.pop_front();
+}
+
+void InsAssembler::add_yaw(const YawSample& s, double wall_now) {
+  pending_.push_back({s, wall_now});
+}
+
+std::vector<AssembledSample> InsAssembler::release(double wall_now) {
+  std::vector<AssembledSample> out;
+  while (!pending_.empty()) {
+    const Pending& p = pending_.front();
+    const bool sway_caught_up = !sway_.empty() && sway_.back().first >= p.s.stamp - p_.same_stamp;
+    const bool waited = wall_now - p.arrived >= p_.pair_wait;
+    const bool full = pending_.size() > p_.max_pending;
+    if (!sway_caught_up && !waited && !full) break;
+    if (full && !sway_caught_up && !waited) ++overflowed_;
+    out.push_back(assemble(p.s));
+    pending_.pop_front();
+  }
+  return out;
+}
+
+AssembledSample InsAssembler::assemble(const YawSample& s) {
+  AssembledSample a;
+  a.stamp = s.stamp;
+  a.r = s.r;
+  a.r_valid = s.r_valid;
+  a.rudder = s.rudder;
+  a.delta = s.delta;
+  a.delta_valid = s.delta_valid;
+  // The last sway sample at or before the stamp (within same_stamp), and the one after it.
+  const std::pair<double, double>* before = nullptr;
+  const std::pair<double, double>* after = nullptr;
+  for (const auto& w : sway_) {
+    if (w.first <= s.stamp + p_.same_stamp) {
+      before = &w;
+    } else {
+      after = &w;
+      break;
+    }
+  }
+  if (before != nullptr && std::abs(before->first - s.stamp) <= p_.same_stamp) {
+    a.v = before->second;
+    a.v_valid = true;
+  } else if (before != nullptr && after != nullptr &&
+             after->first - before->first <= p_.sway_max_age) {
+    const double w = (s.stamp - before->first) / (after->first - before->first);
+    a.v = before->second + w * (after->second - before->second);
+    a.v_valid = true;
+  } else if (before != nullptr && s.stamp - before->first <= p_.sway_max_age) {
+    a.v = before->second;
+    a.v_valid = true;
+  }
+  if (!a.v_valid) ++sway_stale_;
+  return a;
+}
+
+const char* to_string(DiagLevel l) {
+  switch (l) {
+    case DiagLevel::kOk:
+      return "OK";
+    case DiagLevel::kWarn:
+      return "WARN";
+    case DiagLevel::kError:
+      return "ERROR";
+    case DiagLevel::kStale:
+      return "STALE";
+  }
+  return "?";
+}
+
+DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after) {
+  if (!(heard_age <= silent_after)) return DiagLevel::kStale;  // NaN: never heard
+  if (row == nullptr) return DiagLevel::kOk;
+  DiagLevel l = DiagLevel::kOk;
+  switch (row->ev.state) {
+    case FaultState::kRaised:
+      l = DiagLevel::kError;
+      break;
+    case FaultState::kActiveAcknowledged:
+    case FaultState::kClearedUnacknowledged:
+      l = DiagLevel::kWarn;
+      break;
+    case FaultState::kNormal:
+    case FaultState::kAcknowledged:
+      l = DiagLevel::kOk;
+      break;
+  }
+  if (sensor == Sensor::kUnknown && l == DiagLevel::kError) l = DiagLevel::kWarn;
+  return l;
+}
+
+DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,
+                               double silent_after) {
+  DiagStatus d;
+  d.level = diagnostic_level(sensor, row, heard_age, silent_after);
+  d.name = fmt::format("usv_fdi: {} {}", mmsi, to_string(sensor));
+  d.hardware_id = std::to_string(mmsi);
+  if (std::isnan(heard_age)) {
+    d.message = "the vessel's usv-fdi sidecar has not been heard";
+  } else if (d.level == DiagLevel::kStale) {
+    d.message = fmt::format(
+        "the vessel's usv-fdi sidecar has not been heard for {:.1f} s; last "
+        "known state: {}",
+        heard_age, row == nullptr ? "no fault" : to_string(row->ev.state));
+  } else if (row == nullptr) {
+    d.message = "no fault";
+  } else {
+    d.message = fmt::format("{} ({})", to_string(row->ev.state), row->ev.message);
+  }
+  if (row != nullptr) {
+    const FaultEvent& e = row->ev;
+    d.values = {{"C_a", fmt::format("{:.3f}", e.c_a)},
+                {"C_g", fmt::format("{:.3f}", e.c_g)},
+                {"statistic", fmt::format("{:.6g}", e.statistic)},
+                {"threshold", fmt::format("{:.6g}", e.threshold)},
+                {"state", to_string(e.state)},
+                {"sequence", std::to_string(e.sequence)},
+                {"kind", to_string(e.kind)}};
+  }
+  return d;
+}
+
+}  // namespace usvfdi::app::ros2

@@ -1,0 +1,167 @@
+// usv-fdi ros2, the parts without Fast DDS: ROS 2 (REP 103) signs to the project's, stamps,
+// the assembly of INS samples from the yaw-rate and sway-velocity streams, and the
+// diagnostic_msgs/DiagnosticStatus of one vessel's fault instances.
+//
+// Frames. ROS follows REP 103: body x forward, y to PORT, z UP; a yaw rate is positive
+// counter-clockwise seen from above, a sway velocity positive to port. usv-fdi: x forward,
+// y STARBOARD, z DOWN (v and r positive to starboard). Hence
+//   v = -twist.linear.y,   r = -angular_velocity.z.
+// The rudder angle (std_msgs/Float64, radians) has no ROS convention: δ = rudder_sign * data,
+// the sign given by the user (--rudder-sign).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "monitor_model.hpp"
+#include "usv_fdi/core/types.hpp"
+
+namespace usvfdi::app::ros2 {
+
+/// Profiles of the ROS 2 entities in config/qos/usv_fdi_profiles.xml.
+inline constexpr const char* kSensorReaderProfile = "usv_fdi_ros2_sensor_reader";
+inline constexpr const char* kDiagnosticsWriterProfile = "usv_fdi_ros2_diagnostics_writer";
+inline constexpr const char* kFaultEventWriterProfile = "usv_fdi_ros2_fault_event_writer";
+inline constexpr const char* kStatusWriterProfile = "usv_fdi_ros2_status_writer";
+
+/// REP 103 sway velocity (linear.y, positive to port) -> usv-fdi v (positive to starboard).
+inline double sway_from_rep103(double linear_y) { return -linear_y; }
+/// REP 103 yaw rate (angular_velocity.z, positive counter-clockwise from above) -> usv-fdi r
+/// (positive turning to starboard, clockwise from above).
+inline double yaw_rate_from_rep103(double angular_z) { return -angular_z; }
+/// The inverses (for a publisher of ROS messages).
+inline double rep103_linear_y(double v) { return -v; }
+inline double rep103_angular_z(double r) { return -r; }
+
+/// builtin_interfaces/Time -> seconds.
+inline double stamp_seconds(std::int32_t sec, std::uint32_t nanosec) {
+  return static_cast<double>(sec) + 1e-9 * static_cast<double>(nanosec);
+}
+/// Seconds -> builtin_interfaces/Time (nanosec in [0, 1e9)).
+void to_stamp(double t, std::int32_t* sec, std::uint32_t* nanosec);
+
+/// The DDS topic of a ROS 2 topic: "/imu/data" and "imu/data" -> "rt/imu/data" (no node
+/// namespace applies). Empty for a name ROS 2 would refuse (empty, "//", a trailing '/',
+/// characters other than [A-Za-z0-9_/], a token starting with a digit).
+std::string dds_topic_of(const std::string& ros_topic);
+
+struct AssemblyParams {
+  /// A sway sample up to this much older than an INS stamp (source time) is held; older:
+  /// the INS sample's v is invalid (stale) [s]
+  double sway_max_age = 0.2;
+  /// Stamps this close are the same instant [s]
+  double same_stamp = 1e-4;
+  /// An INS sample waits at most this long (wall time) for a sway sample at or after its
+  /// stamp, then is assembled from what there is [s]
+  double pair_wait = 0.2;
+  /// Pending INS samples at most (more: the oldest is assembled at once)
+  std::size_t max_pending = 512;
+};
+
+/// One yaw-rate sample (from sensor_msgs/Imu) with the rudder angle in force when it arrived.
+struct YawSample {
+  double stamp = 0.0;  ///< header.stamp [s]
+  double r = 0.0;      ///< usv-fdi sign [rad/s]
+  bool r_valid = false;
+  bool rudder = false;  ///< a rudder sample goes with it (false: none received, or too old)
+  double delta = 0.0;   ///< usv-fdi sign [rad]
+  bool delta_valid = false;
+};
+
+/// An INS sample (and the rudder angle to go with it) ready for the sidecar.
+struct AssembledSample {
+  double stamp = 0.0;
+  double v = 0.0, r = 0.0;
+  bool v_valid = false, r_valid = false;
+  bool rudder = false;
+  double delta = 0.0;
+  bool delta_valid = false;
+};
+
+/// Assembles INS samples on the yaw-rate (Imu) stamps. Each waits until a sway sample at or
+/// after its stamp has arrived, or for params.pair_wait of wall time; then its v is
+///  * the sway sample at the same stamp (within same_stamp), else
+///  * linear interpolation between the sway samples around its stamp when they are at most
+///    sway_max_age apart, else
+///  * the latest sway sample before its stamp when it is at most sway_max_age old, else
+///    invalid (no sway, or stale).
+/// Samples leave in the order their Imu samples arrived.
+class InsAssembler {
+ public:
+  explicit InsAssembler(const AssemblyParams& p) : p_(p) {}
+
+  void add_sway(double stamp, double v);
+  void add_yaw(const YawSample& s, double wall_now);
+  /// The samples ready at wall time `wall_now`, in order.
+  std::vector<AssembledSample> release(double wall_now);
+
+  std::uint64_t sway_stale() const { return sway_stale_; }        ///< assembled with v invalid
+  std::uint64_t overflowed() const { return overflowed_; }        ///< released early: queue full
+  std::uint64_t sway_rejected() const { return sway_rejected_; }  ///< non-finite or old
+
+ private:
+  struct Pending {
+    YawSample s;
+    double arrived = 0.0;  ///< wall time
+  };
+  AssembledSample assemble(const YawSample& s);
+
+  AssemblyParams p_;
+  std::deque<std::pair<double, double>> sway_;  ///< (stamp, v), stamps increasing
+  std::deque<Pending> pending_;
+  std::uint64_t sway_stale_ = 0, overflowed_ = 0, sway_rejected_ = 0;
+};
+
+/// diagnostic_msgs/DiagnosticStatus levels.
+enum class DiagLevel : std::uint8_t { kOk = 0, kWarn = 1, kError = 2, kStale = 3 };
+const char* to_string(DiagLevel l);
+
+/// One DiagnosticStatus, without Fast DDS.
+struct DiagStatus {
+  DiagLevel level = DiagLevel::kOk;
+  std::string name;
+  std::string message;
+  std::string hardware_id;
+  std::vector<std::pair<std::string, std::string>> values;
+  bool operator==(const DiagStatus& o) const {
+    return level == o.level && name == o.name && message == o.message &&
+           hardware_id == o.hardware_id && values == o.values;
+  }
+  bool operator!=(const DiagStatus& o) const { return !(*this == o); }
+};
+
+/// The level of one fault instance: STALE when the vessel's sidecar has not been heard for
+/// more than silent_after s (heard_age NaN: never heard); else by the latch state: raised ->
+/// ERROR; active-acknowledged or cleared-unacknowledged -> WARN; normal or acknowledged -> OK.
+/// An instance of the unknown sensor (a fault no sensor could be blamed for) is at most WARN.
+/// `row` nullptr: no instance published (OK).
+DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after);
+
+/// The statuses of one vessel: "usv_fdi: <mmsi> accelerometer" and "... gyro" always,
+/// "... unknown" once the sidecar has published that instance. hardware_id is the MMSI;
+/// values C_a, C_g, statistic (J_N), threshold, state, sequence, kind.
+/// `row_of(sensor)` gives the vessel's instance of a sensor or nullptr.
+template <class RowOf>
+std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
+                                           double silent_after);
+
+DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,
+                               double silent_after);
+
+template <class RowOf>
+std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
+                                           double silent_after) {
+  std::vector<DiagStatus> out;
+  for (const Sensor s : {Sensor::kAccelerometer, Sensor::kGyro, Sensor::kUnknown}) {
+    const Row* row = row_of(s);
+    if (s == Sensor::kUnknown && row == nullptr) continue;
+    out.push_back(instance_diagnostic(mmsi, s, row, heard_age, silent_after));
+  }
+  return out;
+}
+
+}  // namespace usvfdi::app::ros2

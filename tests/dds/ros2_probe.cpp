@@ -1,0 +1,328 @@
+// usv_fdi_ros2_probe: a ROS 2 node as seen on the wire, without ROS, for the tests of
+// `usv-fdi ros2`. Topic /name is DDS topic rt/name, types are the ROS 2 types generated with
+// `fastddsgen -typeros2` (sensor_msgs::msg::dds_::Imu_, ...), no partition, QoS as rclcpp's
+// default profile (RELIABLE, VOLATILE, KEEP_LAST 10).
+//
+//   usv_fdi_ros2_probe publish-paper --profiles FILE --domain N --participant-profile P
+//       [--speed S] [--rudder-sign K] [--imu /imu/data] [--twist /velocity]
+//       [--rudder /rudder_angle] [--odometry /odom] [--qos default|sensor_data]
+//       [--timeout SECONDS]
+//     The paper's scenario (Otter, 50 Hz, noise-free; gyro bias on [20, 40) s, accelerometer
+//     bias on [60, 80) s) from the simulator, S times faster than real time (default 10), in
+//     REP 103 signs: per sample std_msgs/Float64 rudder (K * δ, default K = 1), then
+//     sensor_msgs/Imu (angular_velocity.z = -r), then geometry_msgs/TwistStamped
+//     (twist.linear.y = -v), stamps t; with --odometry, nav_msgs/Odometry on that topic
+//     (twist.twist.linear.y = -v) instead of the TwistStamped. --qos sensor_data: writers as
+//     rclcpp's sensor_data profile (BEST_EFFORT, KEEP_LAST 5). Waits (up to the timeout, default 20
+//     s) until a reader matches each writer, prints "publishing", then "published N" and exits 0.
+//
+//   usv_fdi_ros2_probe read-diagnostics --profiles FILE --domain N --participant-profile P
+//     Reads /diagnostics (diagnostic_msgs/DiagnosticArray) and the transient-local mirror
+//     /usv_fdi/fault_event (usv_fdi_msgs/FaultEvent). Prints, per DiagnosticStatus,
+//       diag level=L hardware_id=H name=<name> | key=value key=value ...
+//     and per mirror sample
+//       mirror mmsi=M sensor=S state=T sequence=Q
+//     until SIGTERM/SIGINT (exit 0).
+//
+// Exit code 3: usage error; 4: DDS error.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "diagnostic_msgsPubSubTypes.h"
+#include "geometry_msgsPubSubTypes.h"
+#include "nav_msgsPubSubTypes.h"
+#include "probe_common.hpp"
+#include "sensor_msgsPubSubTypes.h"
+#include "std_msgsPubSubTypes.h"
+#include "usv_fdi/core/simulator.hpp"
+#include "usv_fdi/core/vessel.hpp"
+#include "usv_fdi/dds/profiles.hpp"
+#include "usv_fdi_msgsPubSubTypes.h"
+
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+namespace probe = usvfdi::test_support::probe;
+using eprosima::fastrtps::types::ReturnCode_t;
+using probe::UsageError;
+
+struct DdsError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string mode, profiles, participant_profile = "usv_fdi_participant_loopback";
+  std::uint32_t domain = 0;
+  double speed = 10.0, timeout = 20.0;
+  int rudder_sign = 1;
+  std::string imu = "rt/imu/data", twist = "rt/velocity", rudder = "rt/rudder_angle";
+  std::string odometry;  ///< empty: TwistStamped on `twist`
+  bool sensor_data = false;
+};
+
+std::string rt(const std::string& ros) { return "rt/" + (ros[0] == '/' ? ros.substr(1) : ros); }
+
+Options parse(int argc, char** argv) {
+  if (argc < 2) throw UsageError("usage: usv_fdi_ros2_probe publish-paper|read-diagnostics ...");
+  Options o;
+  o.mode = argv[1];
+  for (int i = 2; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (i + 1 >= argc) throw UsageError(flag + ": missing value");
+    const std::string value = argv[++i];
+    if (flag == "--profiles") {
+      o.profiles = value;
+    } else if (flag == "--domain") {
+      o.domain = static_cast<std::uint32_t>(probe::parse_unsigned(flag, value));
+    } else if (flag == "--participant-profile") {
+      o.participant_profile = value;
+    } else if (flag == "--speed") {
+      o.speed = std::stod(value);
+    } else if (flag == "--timeout") {
+      o.timeout = std::stod(value);
+    } else if (flag == "--rudder-sign") {
+      o.rudder_sign = std::stoi(value);
+    } else if (flag == "--imu") {
+      o.imu = rt(value);
+    } else if (flag == "--twist") {
+      o.twist = rt(value);
+    } else if (flag == "--rudder") {
+      o.rudder = rt(value);
+    } else if (flag == "--odometry") {
+      o.odometry = rt(value);
+    } else if (flag == "--qos") {
+      if (value != "default" && value != "sensor_data") throw UsageError("--qos: " + value);
+      o.sensor_data = value == "sensor_data";
+    } else {
+      throw UsageError("unknown option " + flag);
+    }
+  }
+  if (o.profiles.empty()) throw UsageError("--profiles is required");
+  return o;
+}
+
+/// A participant with ROS 2 topics; everything deleted with it.
+class Node {
+ public:
+  explicit Node(const Options& o) {
+    usvfdi::dds::load_profiles_file(o.profiles);
+    auto* f = fdds::DomainParticipantFactory::get_instance();
+    p_ = f->create_participant_with_profile(o.domain, o.participant_profile);
+    if (p_ == nullptr) throw DdsError("cannot create the participant");
+    pub_ = p_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    sub_ = p_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    if (pub_ == nullptr || sub_ == nullptr) throw DdsError("cannot create publisher/subscriber");
+  }
+  ~Node() {
+    p_->delete_contained_entities();
+    fdds::DomainParticipantFactory::get_instance()->delete_participant(p_);
+  }
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  fdds::Topic* topic(const std::string& name, fdds::TypeSupport type) {
+    if (type.register_type(p_) != ReturnCode_t::RETCODE_OK) throw DdsError("register_type");
+    fdds::Topic* t = p_->create_topic(name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+    if (t == nullptr) throw DdsError("cannot create topic " + name);
+    return t;
+  }
+  /// rclcpp's default publisher QoS: RELIABLE, VOLATILE, KEEP_LAST 10; sensor_data:
+  /// BEST_EFFORT, VOLATILE, KEEP_LAST 5.
+  fdds::DataWriter* writer(fdds::Topic* t, bool sensor_data = false) {
+    fdds::DataWriterQos q = fdds::DATAWRITER_QOS_DEFAULT;
+    q.reliability().kind =
+        sensor_data ? fdds::BEST_EFFORT_RELIABILITY_QOS : fdds::RELIABLE_RELIABILITY_QOS;
+    q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+    q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    q.history().depth = sensor_data ? 5 : 10;
+    fdds::DataWriter* w = pub_->create_datawriter(t, q);
+    if (w == nullptr) throw DdsError("cannot create a writer of " + t->get_name());
+    return w;
+  }
+  fdds::DataReader* reader(fdds::Topic* t, bool transient_local) {
+    fdds::DataReaderQos q = fdds::DATAREADER_QOS_DEFAULT;
+    q.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+    q.durability().kind =
+        transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
+    q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    q.history().depth = 100;
+    fdds::DataReader* r = sub_->create_datareader(t, q);
+    if (r == nullptr) throw DdsError("cannot create a reader of " + t->get_name());
+    return r;
+  }
+
+ private:
+  fdds::DomainParticipant* p_ = nullptr;
+  fdds::Publisher* pub_ = nullptr;
+  fdds::Subscriber* sub_ = nullptr;
+};
+
+void set_stamp(std_msgs::msg::Header* h, double t) {
+  const double whole = std::floor(t);
+  h->stamp().sec(static_cast<std::int32_t>(whole));
+  h->stamp().nanosec(static_cast<std::uint32_t>(std::llround((t - whole) * 1e9)) % 1000000000u);
+}
+
+int publish_paper(const Options& o) {
+  Node n(o);
+  const bool be = o.sensor_data;
+  fdds::DataWriter* rudder_w =
+      n.writer(n.topic(o.rudder, fdds::TypeSupport(new std_msgs::msg::Float64PubSubType())), be);
+  fdds::DataWriter* imu_w =
+      n.writer(n.topic(o.imu, fdds::TypeSupport(new sensor_msgs::msg::ImuPubSubType())), be);
+  fdds::DataWriter* twist_w =
+      o.odometry.empty()
+          ? n.writer(n.topic(o.twist,
+                             fdds::TypeSupport(new geometry_msgs::msg::TwistStampedPubSubType())),
+                     be)
+          : n.writer(
+                n.topic(o.odometry, fdds::TypeSupport(new nav_msgs::msg::OdometryPubSubType())),
+                be);
+  const auto deadline = probe::deadline_after(o.timeout);
+  for (;;) {
+    fdds::PublicationMatchedStatus a, b, c;
+    rudder_w->get_publication_matched_status(a);
+    imu_w->get_publication_matched_status(b);
+    twist_w->get_publication_matched_status(c);
+    if (a.current_count > 0 && b.current_count > 0 && c.current_count > 0) break;
+    if (probe::Clock::now() >= deadline || probe::g_stop.load()) {
+      std::printf("no reader matched\n");
+      return 2;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  // The readers (BEST_EFFORT) match only after their side has discovered us too: a moment.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  std::printf("publishing\n");
+  std::fflush(stdout);
+
+  usvfdi::SimConfig cfg = usvfdi::paper_scenario(usvfdi::otter(), 50.0, 1);
+  cfg.sigma_v = 0.0;  // noise-free, as `usv-fdi sim --noise-scale 0`
+  cfg.sigma_r = 0.0;
+  usvfdi::Simulator sim(cfg);
+  usvfdi::SimRow row;
+  auto t0 = probe::Clock::now();
+  std::uint64_t n_pub = 0;
+  while (!probe::g_stop.load() && sim.next(&row)) {
+    const auto due = t0 + std::chrono::duration_cast<probe::Clock::duration>(
+                              std::chrono::duration<double>(row.t / o.speed));
+    const auto now = probe::Clock::now();
+    if (now > due + std::chrono::milliseconds(250)) {
+      t0 += now - due;  // behind (a busy machine): shift the schedule, no burst
+    } else {
+      std::this_thread::sleep_until(due);
+    }
+    std_msgs::msg::Float64 rudder;
+    rudder.data(o.rudder_sign * row.delta);
+    sensor_msgs::msg::Imu imu;
+    set_stamp(&imu.header(), row.t);
+    imu.header().frame_id("imu_link");
+    imu.orientation().w(1.0);
+    imu.orientation_covariance()[0] = -1.0;  // no orientation estimate
+    imu.angular_velocity().z(-row.r);        // REP 103: z up
+    geometry_msgs::msg::TwistStamped twist;
+    set_stamp(&twist.header(), row.t);
+    twist.header().frame_id("base_link");
+    twist.twist().linear().x(1.0);
+    twist.twist().linear().y(-row.v);  // REP 103: y to port
+    twist.twist().angular().z(-row.r);
+    rudder_w->write(&rudder);
+    imu_w->write(&imu);
+    if (o.odometry.empty()) {
+      twist_w->write(&twist);
+    } else {
+      nav_msgs::msg::Odometry odom;
+      odom.header(twist.header());
+      odom.header().frame_id("odom");
+      odom.child_frame_id("base_link");
+      odom.pose().pose().orientation().w(1.0);
+      odom.twist().twist(twist.twist());
+      twist_w->write(&odom);
+    }
+    ++n_pub;
+  }
+  rudder_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2.0));
+  std::printf("published %llu\n", static_cast<unsigned long long>(n_pub));
+  std::fflush(stdout);
+  return 0;
+}
+
+int read_diagnostics(const Options& o) {
+  Node n(o);
+  fdds::DataReader* diag =
+      n.reader(n.topic("rt/diagnostics",
+                       fdds::TypeSupport(new diagnostic_msgs::msg::DiagnosticArrayPubSubType())),
+               false);
+  fdds::DataReader* mirror =
+      n.reader(n.topic("rt/usv_fdi/fault_event",
+                       fdds::TypeSupport(new usv_fdi_msgs::msg::FaultEventPubSubType())),
+               true);
+  fdds::WaitSet ws;
+  diag->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+  mirror->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+  ws.attach_condition(diag->get_statuscondition());
+  ws.attach_condition(mirror->get_statuscondition());
+  std::printf("reading\n");
+  std::fflush(stdout);
+  while (!probe::g_stop.load()) {
+    fdds::ConditionSeq active;
+    ws.wait(active, eprosima::fastrtps::Duration_t(0.1));
+    fdds::SampleInfo info;
+    diagnostic_msgs::msg::DiagnosticArray a;
+    while (diag->take_next_sample(&a, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      for (const auto& s : a.status()) {
+        std::string line = "diag level=" + std::to_string(s.level()) +
+                           " hardware_id=" + s.hardware_id() + " name=" + s.name() + " |";
+        for (const auto& kv : s.values()) line += " " + kv.key() + "=" + kv.value();
+        std::printf("%s\n", line.c_str());
+      }
+    }
+    usv_fdi_msgs::msg::FaultEvent e;
+    while (mirror->take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      std::printf("mirror mmsi=%u sensor=%u state=%u sequence=%llu\n", e.mmsi(),
+                  static_cast<unsigned>(e.sensor()), static_cast<unsigned>(e.state()),
+                  static_cast<unsigned long long>(e.sequence_number()));
+    }
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  probe::install_signal_handlers();
+  try {
+    const Options o = parse(argc, argv);
+    if (o.mode == "publish-paper") return publish_paper(o);
+    if (o.mode == "read-diagnostics") return read_diagnostics(o);
+    throw UsageError("unknown mode " + o.mode);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "DDS error: %s\n", e.what());
+    return 4;
+  }
+}

@@ -1,0 +1,241 @@
+// End-to-end test of `usv-fdi ros2`: a ROS 2 node as it is on the wire (usv_fdi_ros2_probe:
+// rt/ topics, ROS 2 type names, REP 103 signs) publishes the paper's scenario as
+// sensor_msgs/Imu, geometry_msgs/TwistStamped and a std_msgs/Float64 rudder angle; the real
+// adapter turns them into INS and rudder samples for the real sidecar, and publishes the
+// vessel's faults on /diagnostics, read by another ROS-typed participant. Each in its own
+// process over Fast DDS on loopback.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fleet.hpp"
+#include "test_env.hpp"
+
+namespace usvfdi::dds::test {
+namespace {
+
+using std::chrono::milliseconds;
+using std::chrono::seconds;
+using Clock = std::chrono::steady_clock;
+
+/// One DiagnosticStatus as the probe prints it.
+struct Diag {
+  int level = -1;
+  std::string hardware_id, name;
+  std::map<std::string, std::string> values;
+};
+
+std::optional<Diag> parse_diag(const std::string& line) {
+  if (line.rfind("diag ", 0) != 0) return std::nullopt;
+  Diag d;
+  const auto name_at = line.find(" name=");
+  if (name_at == std::string::npos) return std::nullopt;
+  const auto bar = line.find(" |", name_at);  // " |" then " key=value" per value
+  std::istringstream head(line.substr(5, name_at - 5));
+  std::string tok;
+  while (head >> tok) {
+    if (tok.rfind("level=", 0) == 0) d.level = std::stoi(tok.substr(6));
+    if (tok.rfind("hardware_id=", 0) == 0) d.hardware_id = tok.substr(12);
+  }
+  d.name = line.substr(name_at + 6, (bar == std::string::npos ? line.size() : bar) - name_at - 6);
+  if (bar != std::string::npos) {
+    std::istringstream rest(line.substr(bar + 2));
+    while (rest >> tok) {
+      const auto eq = tok.find('=');
+      if (eq != std::string::npos) d.values[tok.substr(0, eq)] = tok.substr(eq + 1);
+    }
+  }
+  return d;
+}
+
+/// What the /diagnostics reader has seen.
+struct Seen {
+  std::map<std::string, Diag> last;                ///< by status name
+  std::map<std::string, std::vector<int>> levels;  ///< every level in order, by name
+  std::vector<std::string> mirrors;
+  std::string text;
+
+  void add(const std::string& line) {
+    text += line + "\n";
+    if (line.rfind("mirror ", 0) == 0) mirrors.push_back(line);
+    const auto d = parse_diag(line);
+    if (!d) return;
+    auto& l = levels[d->name];
+    if (l.empty() || l.back() != d->level) l.push_back(d->level);
+    last[d->name] = *d;
+  }
+  int level(const std::string& name) const {
+    const auto it = last.find(name);
+    return it == last.end() ? -1 : it->second.level;
+  }
+  bool saw(const std::string& name, int level) const {
+    const auto it = levels.find(name);
+    if (it == levels.end()) return false;
+    for (int l : it->second) {
+      if (l == level) return true;
+    }
+    return false;
+  }
+};
+
+bool read_until(ChildProcess& p, Seen* seen, milliseconds timeout,
+                const std::function<bool()>& done) {
+  const auto end = Clock::now() + timeout;
+  while (!done()) {
+    const auto left = std::chrono::duration_cast<milliseconds>(end - Clock::now());
+    if (left.count() <= 0) return false;
+    const auto line = p.read_line(left);
+    if (!line) return false;
+    seen->add(*line);
+  }
+  return true;
+}
+
+class Ros2Probe {
+ public:
+  Ros2Probe(const Fleet& f, const std::string& name, const std::string& mode,
+            const std::vector<std::string>& extra) {
+    const auto dds = f.dds_args();  // --domain N --partition P ...: ROS 2 uses no partition
+    std::vector<std::string> argv = {USV_FDI_ROS2_PROBE, mode,       "--profiles",
+                                     kProfilesFile,      "--domain", dds.at(1)};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    p_ = std::make_unique<ChildProcess>(argv, f.dir() + name + ".log");
+  }
+  ChildProcess& process() { return *p_; }
+
+ private:
+  std::unique_ptr<ChildProcess> p_;
+};
+
+TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntilAcknowledged) {
+  // GIVEN a sidecar, the ROS 2 adapter (rudder Float64 of the opposite sign to model.B) and a
+  // ROS 2 reader of /diagnostics
+  Fleet f;
+  const unsigned m = 257100041;
+  const std::string ms = std::to_string(m);
+  const std::string accel = "usv_fdi: " + ms + " accelerometer", gyro = "usv_fdi: " + ms + " gyro";
+  f.start_service("svc", f.write_service_config("svc", m), 0);
+  f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "-1", "--reliable", "--silent-after", "3",
+                   "--diagnostics-period", "0.5"});
+  ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
+  Ros2Probe diag(f, "diag", "read-diagnostics", {});
+  Seen seen;
+  // Once the sidecar is heard, both sensors are OK.
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
+                         [&] { return seen.level(accel) == 0 && seen.level(gyro) == 0; }))
+      << seen.text << f.log("ros2");
+  EXPECT_EQ(seen.last[gyro].hardware_id, ms);
+
+  // WHEN a ROS 2 node publishes the paper's scenario (gyro bias on 20-40 s, accelerometer bias
+  // on 60-80 s) on /imu/data, /velocity and /rudder_angle, REP 103 signs, rudder sign -1
+  Ros2Probe pub(f, "pub", "publish-paper", {"--speed", "10", "--rudder-sign", "-1"});
+
+  // THEN the gyro goes ERROR first (the accelerometer still OK), isolated (C_g > C_a)
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(gyro, 2); }))
+      << seen.text << f.log("ros2") << f.log("svc") << f.log("pub");
+  EXPECT_EQ(seen.level(accel), 0) << seen.text;
+  {
+    const Diag& g = seen.last[gyro];
+    EXPECT_EQ(g.values.at("state"), "raised");
+    EXPECT_GT(std::stod(g.values.at("C_g")), std::stod(g.values.at("C_a")));
+    EXPECT_GT(std::stod(g.values.at("statistic")), std::stod(g.values.at("threshold")));
+  }
+  // THEN the accelerometer goes ERROR, isolated (C_a > C_g)
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(accel, 2); }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_GT(std::stod(seen.last[accel].values.at("C_a")),
+            std::stod(seen.last[accel].values.at("C_g")));
+  // THEN, each fault over, both are WARN (cleared, not acknowledged)
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90),
+                         [&] {
+                           return seen.level(accel) == 1 && seen.level(gyro) == 1 &&
+                                  seen.last[accel].values.count("state") &&
+                                  seen.last[accel].values.at("state") == "cleared" &&
+                                  seen.last[gyro].values.at("state") == "cleared";
+                         }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_FALSE(seen.levels.count("usv_fdi: " + ms + " unknown")) << "no unknown-sensor fault\n"
+                                                                 << seen.text;
+
+  // WHEN an operator acknowledges both events (usv-fdi monitor --ack)
+  const auto ack = f.run_to_end("ack",
+                                {"monitor", "--operator", "alice", "--ack",
+                                 ms + ":gyro:" + seen.last[gyro].values.at("sequence"), "--ack",
+                                 ms + ":accelerometer:" + seen.last[accel].values.at("sequence")},
+                                seconds(30));
+  ASSERT_TRUE(ack.has_value()) << f.log("ack");
+  EXPECT_EQ(*ack, 0) << f.log("ack");
+  // THEN both are OK again
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
+                         [&] { return seen.level(accel) == 0 && seen.level(gyro) == 0; }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_EQ(seen.last[gyro].values.at("state"), "acknowledged");
+
+  // The publisher is done, the sidecar saw every sample in order.
+  ASSERT_TRUE(pub.process().wait_exit(seconds(60)).has_value()) << f.log("pub");
+  EXPECT_EQ(*pub.process().wait_exit(milliseconds(0)), 0) << f.log("pub");
+
+  // The keyless mirror of the fault events carries the lifecycle too.
+  EXPECT_GE(seen.mirrors.size(), 4u) << seen.text;
+
+  // WHEN the sidecar stops, THEN the vessel's statuses go STALE
+  f.process("svc").signal(SIGTERM);
+  ASSERT_TRUE(f.process("svc").wait_exit(seconds(10)).has_value());
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
+                         [&] { return seen.level(accel) == 3 && seen.level(gyro) == 3; }))
+      << seen.text << f.log("ros2");
+
+  f.process("ros2").signal(SIGTERM);
+  ASSERT_TRUE(f.process("ros2").wait_exit(seconds(10)).has_value());
+  const std::string log = f.log("ros2");
+  EXPECT_NE(log.find("ros2 adapter stopped"), std::string::npos) << log;
+  diag.process().signal(SIGTERM);
+}
+
+TEST(Ros2EndToEnd, OdometrySwayFromSensorDataPublishersIsolatesBothFaults) {
+  // GIVEN the adapter reading the sway velocity from nav_msgs/Odometry on /odom, and a ROS 2
+  // node whose writers use the sensor_data profile (BEST_EFFORT), rudder in the sign of model.B
+  Fleet f;
+  const unsigned m = 257100042;
+  const std::string ms = std::to_string(m);
+  const std::string accel = "usv_fdi: " + ms + " accelerometer", gyro = "usv_fdi: " + ms + " gyro";
+  f.start_service("svc", f.write_service_config("svc", m), 0);
+  f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "1", "--reliable", "--sway-type",
+                   "odometry", "--sway-topic", "/odom", "--no-mirrors"});
+  ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
+  Ros2Probe diag(f, "diag", "read-diagnostics", {});
+  Seen seen;
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
+                         [&] { return seen.level(accel) == 0 && seen.level(gyro) == 0; }))
+      << seen.text << f.log("ros2");
+  // WHEN the node publishes the paper's scenario
+  Ros2Probe pub(f, "pub", "publish-paper",
+                {"--speed", "10", "--odometry", "/odom", "--qos", "sensor_data"});
+  // THEN the gyro, then the accelerometer go ERROR, each isolated, and both clear
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(gyro, 2); }))
+      << seen.text << f.log("ros2") << f.log("svc") << f.log("pub");
+  EXPECT_EQ(seen.level(accel), 0) << seen.text;
+  EXPECT_GT(std::stod(seen.last[gyro].values.at("C_g")),
+            std::stod(seen.last[gyro].values.at("C_a")));
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(accel, 2); }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_GT(std::stod(seen.last[accel].values.at("C_a")),
+            std::stod(seen.last[accel].values.at("C_g")));
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90),
+                         [&] { return seen.level(accel) == 1 && seen.level(gyro) == 1; }))
+      << seen.text << f.log("ros2") << f.log("svc");
+  EXPECT_TRUE(seen.mirrors.empty()) << "--no-mirrors\n" << seen.text;
+  ASSERT_TRUE(pub.process().wait_exit(seconds(60)).has_value()) << f.log("pub");
+  diag.process().signal(SIGTERM);
+}
+
+}  // namespace
+}  // namespace usvfdi::dds::test

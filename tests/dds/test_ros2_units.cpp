@@ -1,0 +1,197 @@
+// Units of `usv-fdi ros2` without DDS (src/app/ros2_adapter.*): REP 103 signs, stamps, topic
+// names, the assembly of INS samples, and the diagnostics levels.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "ros2_adapter.hpp"
+
+namespace usvfdi::app::ros2 {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TEST(Ros2Signs, AVesselTurningToStarboardHasAPositiveYawRate) {
+  // GIVEN a vessel turning to starboard (clockwise seen from above): in REP 103 (z up) its
+  // angular_velocity.z is negative
+  const double angular_z = -0.05;
+  // THEN usv-fdi's r (z down) is positive
+  EXPECT_DOUBLE_EQ(yaw_rate_from_rep103(angular_z), 0.05);
+  EXPECT_DOUBLE_EQ(rep103_angular_z(yaw_rate_from_rep103(angular_z)), angular_z);
+}
+
+TEST(Ros2Signs, AVesselDriftingToStarboardHasAPositiveSwayVelocity) {
+  // GIVEN a vessel drifting to starboard: in REP 103 (y to port) linear.y is negative
+  const double linear_y = -0.2;
+  // THEN usv-fdi's v (y to starboard) is positive
+  EXPECT_DOUBLE_EQ(sway_from_rep103(linear_y), 0.2);
+  EXPECT_DOUBLE_EQ(rep103_linear_y(sway_from_rep103(linear_y)), linear_y);
+}
+
+TEST(Ros2Stamps, SecondsAndNanosecondsRoundTrip) {
+  EXPECT_DOUBLE_EQ(stamp_seconds(12, 500000000u), 12.5);
+  std::int32_t s = 0;
+  std::uint32_t ns = 0;
+  to_stamp(20.02, &s, &ns);
+  EXPECT_EQ(s, 20);
+  EXPECT_NEAR(ns, 20000000u, 1u);
+  to_stamp(0.9999999999, &s, &ns);  // rounds up to the next second, never nanosec = 1e9
+  EXPECT_EQ(s, 1);
+  EXPECT_EQ(ns, 0u);
+  to_stamp(1.7e9 + 0.25, &s, &ns);
+  EXPECT_EQ(s, 1700000000);
+  EXPECT_NEAR(ns, 250000000u, 1000u);
+}
+
+TEST(Ros2Topics, AbsoluteAndRelativeNamesMapToRt) {
+  EXPECT_EQ(dds_topic_of("/imu/data"), "rt/imu/data");
+  EXPECT_EQ(dds_topic_of("imu/data"), "rt/imu/data");
+  EXPECT_EQ(dds_topic_of("/diagnostics"), "rt/diagnostics");
+  EXPECT_EQ(dds_topic_of(""), "");
+  EXPECT_EQ(dds_topic_of("/"), "");
+  EXPECT_EQ(dds_topic_of("/imu//data"), "");
+  EXPECT_EQ(dds_topic_of("/imu/"), "");
+  EXPECT_EQ(dds_topic_of("/imu data"), "");
+  EXPECT_EQ(dds_topic_of("/2imu"), "");
+}
+
+YawSample yaw(double t, double r, double delta = 0.1) {
+  YawSample y;
+  y.stamp = t;
+  y.r = r;
+  y.r_valid = true;
+  y.rudder = true;
+  y.delta = delta;
+  y.delta_valid = true;
+  return y;
+}
+
+TEST(Ros2Assembly, AnImuSampleWaitsForTheSwaySampleOfItsStamp) {
+  InsAssembler a(AssemblyParams{});
+  a.add_yaw(yaw(1.00, 0.01), 0.0);
+  EXPECT_TRUE(a.release(0.01).empty()) << "no sway sample at or after 1.00 yet";
+  a.add_sway(1.00, 0.3);
+  const auto out = a.release(0.02);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_DOUBLE_EQ(out[0].stamp, 1.00);
+  EXPECT_DOUBLE_EQ(out[0].v, 0.3);
+  EXPECT_TRUE(out[0].v_valid);
+  EXPECT_DOUBLE_EQ(out[0].r, 0.01);
+  EXPECT_TRUE(out[0].rudder);
+  EXPECT_DOUBLE_EQ(out[0].delta, 0.1);
+}
+
+TEST(Ros2Assembly, BetweenTwoSwaySamplesVIsInterpolated) {
+  InsAssembler a(AssemblyParams{});
+  a.add_sway(1.0, 0.2);
+  a.add_yaw(yaw(1.05, 0.0), 0.0);
+  a.add_sway(1.1, 0.4);
+  const auto out = a.release(0.0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(out[0].v, 0.3, 1e-12);
+  EXPECT_TRUE(out[0].v_valid);
+}
+
+TEST(Ros2Assembly, AfterThePairWaitTheLatestSwayIsHeldUntilItIsStale) {
+  AssemblyParams p;
+  p.sway_max_age = 0.2;
+  p.pair_wait = 0.1;
+  InsAssembler a(p);
+  a.add_sway(1.0, 0.2);
+  a.add_yaw(yaw(1.15, 0.0), 0.0);  // 0.15 s after the last sway sample: held
+  a.add_yaw(yaw(1.25, 0.0), 0.0);  // 0.25 s: stale
+  EXPECT_TRUE(a.release(0.05).empty()) << "still waiting for the sway stream";
+  const auto out = a.release(0.1);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_TRUE(out[0].v_valid);
+  EXPECT_DOUBLE_EQ(out[0].v, 0.2);
+  EXPECT_FALSE(out[1].v_valid);
+  EXPECT_EQ(a.sway_stale(), 1u);
+}
+
+TEST(Ros2Assembly, NoSwayAtAllGivesInvalidVButKeepsR) {
+  AssemblyParams p;
+  p.pair_wait = 0.0;
+  InsAssembler a(p);
+  a.add_yaw(yaw(3.0, -0.02), 0.0);
+  const auto out = a.release(0.0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_FALSE(out[0].v_valid);
+  EXPECT_TRUE(out[0].r_valid);
+  EXPECT_DOUBLE_EQ(out[0].r, -0.02);
+}
+
+TEST(Ros2Assembly, SamplesLeaveInArrivalOrderAndBackwardSwayStampsAreRefused) {
+  InsAssembler a(AssemblyParams{});
+  for (int k = 0; k < 5; ++k) a.add_yaw(yaw(0.02 * k, 0.001 * k), 0.0);
+  for (int k = 0; k < 5; ++k) a.add_sway(0.02 * k, 0.1 * k);
+  a.add_sway(0.02, 9.0);  // backward
+  a.add_sway(kNaN, 9.0);
+  EXPECT_EQ(a.sway_rejected(), 2u);
+  const auto out = a.release(0.0);
+  ASSERT_EQ(out.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_DOUBLE_EQ(out[k].stamp, 0.02 * k);
+    EXPECT_NEAR(out[k].v, 0.1 * k, 1e-12);
+  }
+}
+
+Row row(Sensor s, FaultState st) {
+  Row r;
+  r.mmsi = 257000001;
+  r.ev.sensor = s;
+  r.ev.state = st;
+  r.ev.kind = FaultKind::kBias;
+  r.ev.c_a = 0.0;
+  r.ev.c_g = 1.0;
+  r.ev.statistic = 14.08;
+  r.ev.threshold = 12.0;
+  r.ev.sequence = 3;
+  r.ev.message = "residual";
+  return r;
+}
+
+TEST(Ros2Diagnostics, LevelsFollowTheLatchState) {
+  const double heard = 0.5, silent_after = 5.0;
+  const Sensor g = Sensor::kGyro;
+  const Row raised = row(g, FaultState::kRaised), acked = row(g, FaultState::kActiveAcknowledged),
+            cleared = row(g, FaultState::kClearedUnacknowledged),
+            done = row(g, FaultState::kAcknowledged), normal = row(g, FaultState::kNormal);
+  EXPECT_EQ(diagnostic_level(g, nullptr, heard, silent_after), DiagLevel::kOk);
+  EXPECT_EQ(diagnostic_level(g, &normal, heard, silent_after), DiagLevel::kOk);
+  EXPECT_EQ(diagnostic_level(g, &raised, heard, silent_after), DiagLevel::kError);
+  EXPECT_EQ(diagnostic_level(g, &acked, heard, silent_after), DiagLevel::kWarn);
+  EXPECT_EQ(diagnostic_level(g, &cleared, heard, silent_after), DiagLevel::kWarn);
+  EXPECT_EQ(diagnostic_level(g, &done, heard, silent_after), DiagLevel::kOk);
+  // A fault no sensor could be blamed for is a warning, not an error of a sensor.
+  const Row unknown = row(Sensor::kUnknown, FaultState::kRaised);
+  EXPECT_EQ(diagnostic_level(Sensor::kUnknown, &unknown, heard, silent_after), DiagLevel::kWarn);
+}
+
+TEST(Ros2Diagnostics, ASilentOrNeverHeardSidecarIsStale) {
+  const Row raised = row(Sensor::kGyro, FaultState::kRaised);
+  EXPECT_EQ(diagnostic_level(Sensor::kGyro, &raised, 6.0, 5.0), DiagLevel::kStale);
+  EXPECT_EQ(diagnostic_level(Sensor::kGyro, nullptr, kNaN, 5.0), DiagLevel::kStale);
+  EXPECT_EQ(diagnostic_level(Sensor::kGyro, &raised, 5.0, 5.0), DiagLevel::kError);
+}
+
+TEST(Ros2Diagnostics, OneStatusPerSensorNamedByVesselWithTheEventsValues) {
+  const Row g = row(Sensor::kGyro, FaultState::kRaised);
+  const auto st = vessel_diagnostics(
+      257000001, [&](Sensor s) { return s == Sensor::kGyro ? &g : nullptr; }, 0.1, 5.0);
+  ASSERT_EQ(st.size(), 2u) << "accelerometer and gyro; no unknown-sensor instance";
+  EXPECT_EQ(st[0].name, "usv_fdi: 257000001 accelerometer");
+  EXPECT_EQ(st[0].level, DiagLevel::kOk);
+  EXPECT_TRUE(st[0].values.empty());
+  EXPECT_EQ(st[1].name, "usv_fdi: 257000001 gyro");
+  EXPECT_EQ(st[1].hardware_id, "257000001");
+  EXPECT_EQ(st[1].level, DiagLevel::kError);
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {"C_a", "0.000"},    {"C_g", "1.000"},  {"statistic", "14.08"}, {"threshold", "12"},
+      {"state", "raised"}, {"sequence", "3"}, {"kind", "bias"}};
+  EXPECT_EQ(st[1].values, want);
+}
+
+}  // namespace
+}  // namespace usvfdi::app::ros2
