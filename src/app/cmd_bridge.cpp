@@ -14,10 +14,6 @@
 // silence, responsibility transfer, nothing to acknowledge, or no confirmation within
 // --ack-timeout -> ARC. ACNs for other equipment's alerts are ignored; bad datagrams and
 // sentences are counted by reason and logged (rate-limited), and never act.
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <spdlog/spdlog.h>
 
@@ -40,6 +36,7 @@
 #include "usv_fdi/core/text.hpp"
 #include "usv_fdi/io/config.hpp"
 #include "usv_fdi/nmea/datagram.hpp"
+#include "usv_fdi/nmea_udp/udp.hpp"
 
 namespace usvfdi::app {
 namespace {
@@ -62,85 +59,6 @@ struct BridgeArgs {
   double silent_after = 5.0;
   std::string operator_prefix = "bridge";
 };
-
-/// "a.b.c.d:port" -> sockaddr_in; false and *why when malformed.
-bool parse_endpoint(const std::string& text, sockaddr_in* out, std::string* why) {
-  const auto colon = text.rfind(':');
-  std::memset(out, 0, sizeof *out);
-  out->sin_family = AF_INET;
-  if (colon == std::string::npos) {
-    *why = "'" + text + "' is not ADDRESS:PORT";
-    return false;
-  }
-  const std::string host = text.substr(0, colon), port = text.substr(colon + 1);
-  if (inet_pton(AF_INET, host.c_str(), &out->sin_addr) != 1) {
-    *why = "'" + host + "' is not an IPv4 address";
-    return false;
-  }
-  char* end = nullptr;
-  const long p = std::strtol(port.c_str(), &end, 10);
-  if (port.empty() || *end != '\0' || p < 1 || p > 65535) {
-    *why = "'" + port + "' is not a port (1..65535)";
-    return false;
-  }
-  out->sin_port = htons(static_cast<std::uint16_t>(p));
-  return true;
-}
-
-bool is_multicast(const sockaddr_in& a) { return IN_MULTICAST(ntohl(a.sin_addr.s_addr)); }
-
-/// A UDP socket; closed when destroyed.
-class Socket {
- public:
-  Socket() : fd_(::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0)) {
-    if (fd_ < 0) throw std::runtime_error(std::string("socket: ") + std::strerror(errno));
-  }
-  ~Socket() { ::close(fd_); }
-  Socket(const Socket&) = delete;
-  Socket& operator=(const Socket&) = delete;
-  int fd() const { return fd_; }
-  void option(int level, int name, const void* value, socklen_t size, const char* what) const {
-    if (::setsockopt(fd_, level, name, value, size) != 0) {
-      throw std::runtime_error(std::string(what) + ": " + std::strerror(errno));
-    }
-  }
-
- private:
-  int fd_;
-};
-
-/// The sender of the alert sentences: to a multicast group (TTL 1, looped back to this host
-/// too) or a unicast address, from the configured interface.
-std::unique_ptr<Socket> open_sender(const sockaddr_in& to, const in_addr& iface) {
-  auto s = std::make_unique<Socket>();
-  if (is_multicast(to)) {
-    const unsigned char ttl = 1, loop = 1;
-    s->option(IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl, "IP_MULTICAST_TTL");
-    s->option(IPPROTO_IP, IP_MULTICAST_LOOP, &loop, sizeof loop, "IP_MULTICAST_LOOP");
-    s->option(IPPROTO_IP, IP_MULTICAST_IF, &iface, sizeof iface, "IP_MULTICAST_IF");
-  }
-  return s;
-}
-
-/// The receiver of ACNs: bound to the port (a multicast group joined on the interface), or to
-/// a unicast address. Non-blocking.
-std::unique_ptr<Socket> open_receiver(const sockaddr_in& at, const in_addr& iface) {
-  auto s = std::make_unique<Socket>();
-  const int one = 1;
-  s->option(SOL_SOCKET, SO_REUSEADDR, &one, sizeof one, "SO_REUSEADDR");
-  sockaddr_in bind_to = at;
-  if (is_multicast(at)) bind_to.sin_addr.s_addr = htonl(INADDR_ANY);
-  if (::bind(s->fd(), reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0) {
-    throw std::runtime_error(std::string("bind: ") + std::strerror(errno));
-  }
-  if (is_multicast(at)) {
-    ip_mreq m{};
-    m.imr_multiaddr = at.sin_addr;
-    m.imr_interface = iface;
-    s->option(IPPROTO_IP, IP_ADD_MEMBERSHIP, &m, sizeof m, "IP_ADD_MEMBERSHIP");
-  }
-  return s;
-}
 
 /// Counts of what was received and did not act, logged with a rate limit: the first 5 of each
 /// reason, then every 100th.
@@ -173,9 +91,9 @@ struct PendingAck {
 
 class Bridge {
  public:
-  Bridge(const BridgeArgs& a, dds::DdsContext& ctx, FleetView& view, const sockaddr_in& out,
-         std::unique_ptr<Socket> tx, std::unique_ptr<Socket> rx)
-      : a_(a), ctx_(ctx), view_(view), out_(out), tx_(std::move(tx)), rx_(std::move(rx)) {
+  Bridge(const BridgeArgs& a, dds::DdsContext& ctx, FleetView& view,
+         std::unique_ptr<nmea_udp::NmeaUdpSender> tx, std::unique_ptr<nmea_udp::UdpListener> rx)
+      : a_(a), ctx_(ctx), view_(view), tx_(std::move(tx)), rx_(std::move(rx)) {
     ack_writer_ =
         &ctx.create_writer_in_partitions(dds::TopicId::kFaultAck, dds::profiles::kFaultAckWriter,
                                          ack_partitions(ctx.config().publisher_partitions, a.mmsi));
@@ -230,10 +148,8 @@ class Bridge {
       spdlog::error("bridge: cannot format a datagram: {}", d.rejection().text);
       return;
     }
-    const std::string& bytes = d.value();
-    if (::sendto(tx_->fd(), bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&out_),
-                 sizeof out_) < 0) {
-      spdlog::warn("bridge: sendto {} failed: {}", a_.out, std::strerror(errno));
+    if (!tx_->send(d.value())) {
+      spdlog::warn("bridge: sending to {} failed: {}", a_.out, std::strerror(errno));
       return;
     }
     ++sent_;
@@ -301,39 +217,31 @@ class Bridge {
   }
 
   void read_acns() {
-    char buf[nmea::kMaxDatagramLength + 1];
-    for (int k = 0; k < 64; ++k) {  // bounded per turn
-      sockaddr_in from{};
-      socklen_t len = sizeof from;
-      const ssize_t n = ::recvfrom(rx_->fd(), buf, sizeof buf, MSG_DONTWAIT,
-                                   reinterpret_cast<sockaddr*>(&from), &len);
-      if (n < 0) return;  // EAGAIN: nothing more
-      char who[INET_ADDRSTRLEN] = "?";
-      inet_ntop(AF_INET, &from.sin_addr, who, sizeof who);
-      const auto d = nmea::parse_datagram(std::string_view(buf, static_cast<std::size_t>(n)));
+    rx_->read(0, [this](std::string_view bytes, const std::string& who) {
+      const auto d = nmea::parse_datagram(bytes);
       if (!d.ok()) {
         rejections_.count(nmea::to_string(d.rejection().reason),
-                          std::string("datagram from ") + who + ": " + d.rejection().text);
-        continue;
+                          "datagram from " + who + ": " + d.rejection().text);
+        return;
       }
       for (const auto& line : d.value().lines) {
         if (!line.ok()) {
           rejections_.count(nmea::to_string(line.rejection().reason),
-                            std::string("from ") + who + ": " + line.rejection().text);
+                            "from " + who + ": " + line.rejection().text);
           continue;
         }
         on_sentence(line.value(), who);
       }
-    }
+    });
   }
 
-  void on_sentence(const nmea::TaggedSentence& ts, const char* who) {
+  void on_sentence(const nmea::TaggedSentence& ts, const std::string& who) {
     const nmea::Sentence& s = ts.sentence;
     if (s.formatter != "ACN") return;  // the network carries everything; only ACN is ours
     const auto acn = nmea::parse_acn(s);
     if (!acn.ok()) {
       rejections_.count(std::string("ACN ") + nmea::to_string(acn.rejection().reason),
-                        std::string("from ") + who + ": " + acn.rejection().text);
+                        "from " + who + ": " + acn.rejection().text);
       return;
     }
     const Row* row = nullptr;
@@ -399,8 +307,8 @@ class Bridge {
   const BridgeArgs& a_;
   dds::DdsContext& ctx_;
   FleetView& view_;
-  sockaddr_in out_;
-  std::unique_ptr<Socket> tx_, rx_;
+  std::unique_ptr<nmea_udp::NmeaUdpSender> tx_;
+  std::unique_ptr<nmea_udp::UdpListener> rx_;
   fdds::DataWriter* ack_writer_ = nullptr;
   std::map<int, std::pair<std::uint64_t, FaultState>> shown_;
   std::vector<PendingAck> pending_;
@@ -440,17 +348,16 @@ int run_bridge(BridgeArgs& a) {
   block_stop_signals();
   route_fastdds_log_to_spdlog();
   if (!alert_settings(&a)) return kExitUsage;
-  sockaddr_in out{}, in{}, iface_addr{};
-  std::string why;
-  if (!parse_endpoint(a.out, &out, &why) || !parse_endpoint(a.in, &in, &why) ||
-      !parse_endpoint(a.interface_address + ":1", &iface_addr, &why)) {
-    spdlog::error("bridge: {}", why);
-    return kExitUsage;
-  }
-  std::unique_ptr<Socket> tx, rx;
+  std::unique_ptr<nmea_udp::NmeaUdpSender> tx;
+  std::unique_ptr<nmea_udp::UdpListener> rx;
   try {
-    tx = open_sender(out, iface_addr.sin_addr);
-    rx = open_receiver(in, iface_addr.sin_addr);
+    const std::string iface = a.interface_address == "0.0.0.0" ? "" : a.interface_address;
+    tx = std::make_unique<nmea_udp::NmeaUdpSender>(nmea_udp::parse_endpoint(a.out), iface, 1);
+    rx = std::make_unique<nmea_udp::UdpListener>(nmea_udp::parse_endpoint(a.in), iface, 1 << 20,
+                                                 "bridge ACN input");
+  } catch (const std::invalid_argument& e) {
+    spdlog::error("bridge: {}", e.what());
+    return kExitUsage;
   } catch (const std::exception& e) {
     spdlog::error("bridge: cannot open the UDP sockets (out {}, in {}): {}", a.out, a.in, e.what());
     return kExitFailure;
@@ -471,7 +378,7 @@ int run_bridge(BridgeArgs& a) {
   try {
     ctx = std::make_unique<dds::DdsContext>(cfg);
     view = std::make_unique<FleetView>(*ctx, view_args);
-    bridge = std::make_unique<Bridge>(a, *ctx, *view, out, std::move(tx), std::move(rx));
+    bridge = std::make_unique<Bridge>(a, *ctx, *view, std::move(tx), std::move(rx));
   } catch (const std::exception& e) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;

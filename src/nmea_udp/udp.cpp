@@ -157,17 +157,18 @@ std::vector<nmea::StaleInput> DatagramDecoder::stale() const {
   return assembler_.stale(latest_t_);
 }
 
-NmeaUdpReceiver::NmeaUdpReceiver(const ReceiverConfig& config)
-    : decoder_(config.assembler), buffer_(kReadBuffer) {
-  const in_addr address = to_in_addr(config.endpoint.address);
+UdpListener::UdpListener(const Endpoint& endpoint, const std::string& interface_address,
+                         int receive_buffer, const std::string& what)
+    : buffer_(kReadBuffer) {
+  const in_addr address = to_in_addr(endpoint.address);
   multicast_ = IN_MULTICAST(ntohl(address.s_addr));
   in_addr iface{};
   iface.s_addr = htonl(INADDR_ANY);
-  if (!config.interface_address.empty()) iface = to_in_addr(config.interface_address);
-  const std::string where = config.endpoint.address + ":" + std::to_string(config.endpoint.port);
+  if (!interface_address.empty()) iface = to_in_addr(interface_address);
+  const std::string where = endpoint.address + ":" + std::to_string(endpoint.port);
 
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-  if (fd_ < 0) throw std::runtime_error(system_error("NMEA input: socket"));
+  if (fd_ < 0) throw std::runtime_error(system_error(what + ": socket"));
   const auto fail = [this](const std::string& what) {
     const std::string msg = system_error(what);
     ::close(fd_);
@@ -176,52 +177,51 @@ NmeaUdpReceiver::NmeaUdpReceiver(const ReceiverConfig& config)
   };
   const int one = 1;
   if (::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0) {
-    fail("NMEA input " + where + ": SO_REUSEADDR");
+    fail(what + " " + where + ": SO_REUSEADDR");
   }
-  if (config.receive_buffer > 0) {
+  if (receive_buffer > 0) {
     // A short burst must not overflow the queue while the thread is busy; the kernel caps
     // the request at net.core.rmem_max (the granted size is logged).
-    (void)::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &config.receive_buffer,
-                       sizeof config.receive_buffer);
+    (void)::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
   }
   socklen_t len = sizeof rcvbuf_;
   if (::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf_, &len) != 0) rcvbuf_ = 0;
   sockaddr_in bind_to{};
   bind_to.sin_family = AF_INET;
-  bind_to.sin_port = htons(config.endpoint.port);
+  bind_to.sin_port = htons(endpoint.port);
   // Multicast: bound to the group, so that only its datagrams arrive (not those of another
   // group on the same port); unicast: the local address given.
   bind_to.sin_addr = address;
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0) {
-    fail("NMEA input: cannot bind " + where);
+    fail(what + ": cannot bind " + where);
   }
   if (multicast_) {
     ip_mreq m{};
     m.imr_multiaddr = address;
     m.imr_interface = iface;
     if (::setsockopt(fd_, IPPROTO_IP, IP_ADD_MEMBERSHIP, &m, sizeof m) != 0) {
-      fail("NMEA input: cannot join the multicast group " + where + " on " +
-           (config.interface_address.empty() ? std::string("any interface")
-                                             : config.interface_address));
+      fail(what + ": cannot join the multicast group " + where + " on " +
+           (interface_address.empty() ? std::string("any interface") : interface_address));
     }
   }
   sockaddr_in bound{};
   socklen_t blen = sizeof bound;
   port_ = ::getsockname(fd_, reinterpret_cast<sockaddr*>(&bound), &blen) == 0
               ? ntohs(bound.sin_port)
-              : config.endpoint.port;
-  const std::string at = config.endpoint.address + ":" + std::to_string(port_);
+              : endpoint.port;
+  const std::string at = endpoint.address + ":" + std::to_string(port_);
   description_ = multicast_ ? "multicast group " + at + " on " +
-                                  (config.interface_address.empty() ? std::string("any interface")
-                                                                    : config.interface_address)
+                                  (interface_address.empty() ? std::string("any interface")
+                                                             : interface_address)
                             : "unicast " + at;
 }
 
-NmeaUdpReceiver::~NmeaUdpReceiver() {
+UdpListener::~UdpListener() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-int NmeaUdpReceiver::poll(int timeout_ms) {
+int UdpListener::read(
+    int timeout_ms, const std::function<void(std::string_view, const std::string&)>& on_datagram) {
   pollfd p{};
   p.fd = fd_;
   p.events = POLLIN;
@@ -231,17 +231,32 @@ int NmeaUdpReceiver::poll(int timeout_ms) {
   int n = 0;
   // Bounded, so that a flood cannot keep the caller from handing samples on or stopping.
   while (n < kMaxPerPoll) {
-    const ssize_t got = ::recv(fd_, buffer_.data(), buffer_.size(), 0);
+    sockaddr_in from{};
+    socklen_t from_len = sizeof from;
+    const ssize_t got = ::recvfrom(fd_, buffer_.data(), buffer_.size(), 0,
+                                   reinterpret_cast<sockaddr*>(&from), &from_len);
     if (got < 0) {
       if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) return n;
       return n > 0 ? n : -1;
     }
-    const double now =
-        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-    decoder_.add(std::string_view(buffer_.data(), static_cast<std::size_t>(got)), now);
+    char sender[INET_ADDRSTRLEN] = "?";
+    ::inet_ntop(AF_INET, &from.sin_addr, sender, sizeof sender);
+    on_datagram(std::string_view(buffer_.data(), static_cast<std::size_t>(got)), sender);
     ++n;
   }
   return n;
+}
+
+NmeaUdpReceiver::NmeaUdpReceiver(const ReceiverConfig& config)
+    : decoder_(config.assembler),
+      socket_(config.endpoint, config.interface_address, config.receive_buffer, "NMEA input") {}
+
+int NmeaUdpReceiver::poll(int timeout_ms) {
+  return socket_.read(timeout_ms, [this](std::string_view bytes, const std::string&) {
+    const double now =
+        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    decoder_.add(bytes, now);
+  });
 }
 
 NmeaUdpSender::NmeaUdpSender(const Endpoint& to, const std::string& interface_address, int ttl) {

@@ -25,6 +25,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <string_view>
@@ -101,22 +102,24 @@ class DatagramDecoder {
   std::vector<std::string> examples_;
 };
 
-/// The receiving socket. Not thread-safe: one thread polls it.
-class NmeaUdpReceiver {
+/// A receiving UDP socket: bound to a multicast group (joined on an interface) or a unicast
+/// address, non-blocking. Not thread-safe: one thread polls it.
+class UdpListener {
  public:
-  /// Opens, binds and joins. Throws std::runtime_error naming the address and the system's
-  /// reason, std::invalid_argument for a bad address or assembler configuration.
-  explicit NmeaUdpReceiver(const ReceiverConfig& config);
-  ~NmeaUdpReceiver();
-  NmeaUdpReceiver(const NmeaUdpReceiver&) = delete;
-  NmeaUdpReceiver& operator=(const NmeaUdpReceiver&) = delete;
+  /// Opens, binds and joins; `what` names it in errors ("NMEA input"). Throws
+  /// std::runtime_error naming the address and the system's reason, std::invalid_argument for a
+  /// bad address.
+  UdpListener(const Endpoint& endpoint, const std::string& interface_address, int receive_buffer,
+              const std::string& what);
+  ~UdpListener();
+  UdpListener(const UdpListener&) = delete;
+  UdpListener& operator=(const UdpListener&) = delete;
 
-  /// Waits up to timeout_ms for a datagram (poll), then reads the datagrams waiting (at most
-  /// 256) into the decoder. Returns the datagrams read; -1 on a socket error (errno kept; EINTR is
-  /// 0).
-  int poll(int timeout_ms);
-  DatagramDecoder& decoder() { return decoder_; }
-  const DatagramDecoder& decoder() const { return decoder_; }
+  /// Waits up to timeout_ms for a datagram (poll), then hands the datagrams waiting (at most
+  /// 256) to `on_datagram(bytes, sender address)`. Returns the datagrams read; -1 on a socket
+  /// error (errno kept; EINTR is 0).
+  int read(int timeout_ms,
+           const std::function<void(std::string_view, const std::string&)>& on_datagram);
   /// The receive buffer the kernel granted [bytes].
   int receive_buffer() const { return rcvbuf_; }
   bool multicast() const { return multicast_; }
@@ -127,12 +130,32 @@ class NmeaUdpReceiver {
 
  private:
   int fd_ = -1;
-  DatagramDecoder decoder_;
   int rcvbuf_ = 0;
   bool multicast_ = false;
   std::uint16_t port_ = 0;
   std::string description_;
   std::vector<char> buffer_;
+};
+
+/// The NMEA input: a UdpListener whose datagrams go to a DatagramDecoder.
+class NmeaUdpReceiver {
+ public:
+  /// Throws as UdpListener, and std::invalid_argument for a bad assembler configuration.
+  explicit NmeaUdpReceiver(const ReceiverConfig& config);
+
+  /// Waits up to timeout_ms for a datagram, then reads the datagrams waiting (at most 256) into
+  /// the decoder. Returns the datagrams read; -1 on a socket error (errno kept; EINTR is 0).
+  int poll(int timeout_ms);
+  DatagramDecoder& decoder() { return decoder_; }
+  const DatagramDecoder& decoder() const { return decoder_; }
+  int receive_buffer() const { return socket_.receive_buffer(); }
+  bool multicast() const { return socket_.multicast(); }
+  const std::string& describe() const { return socket_.describe(); }
+  std::uint16_t port() const { return socket_.port(); }
+
+ private:
+  DatagramDecoder decoder_;
+  UdpListener socket_;
 };
 
 /// Sends datagrams to a multicast group (or a unicast address).
