@@ -45,7 +45,8 @@
 //
 // 5. Input fan-out. For each N of --fanout (default 5,10,20,40): N sidecars (one MMSI each)
 //    and one `usv-fdi sim --publish` of N healthy Otter voyages at 10 Hz in real time, all on
-//    one partition; the sidecars' CPU over --fanout-seconds (after 5 s), with
+//    one partition and clients of a discovery server (as in part 4); the sidecars' CPU over
+//    --fanout-seconds (from 5 s after the simulator starts publishing), with
 //    service.content_filter false (every sidecar receives every vessel's stream and drops the
 //    others') and true (the shipped default), one after the other.
 //
@@ -855,23 +856,57 @@ class LineTail {
 };
 
 /// Part 4 for one fleet size: discovery time, monitor CPU/RSS, event latency.
+/// The documented fleet configuration on 127.0.0.1: a Fast DDS discovery server (profile
+/// usv_fdi_discovery_server_udp of docker/fleet_participants.xml) and, while it lives, the
+/// environment that makes the children started meanwhile its clients (ROS_DISCOVERY_SERVER,
+/// that file as FASTRTPS_DEFAULT_PROFILES_FILE); args() are their DDS options.
+class FleetDiscovery {
+ public:
+  FleetDiscovery(const Driver& d, const std::string& tag, int port, const std::string& partition)
+      : d_(d), partition_(partition) {
+    // The server must not see ROS_DISCOVERY_SERVER (the 2.9 server then aborts).
+    clear_env();
+    server_ = std::make_unique<Child>(
+        std::vector<std::string>{"/usr/bin/fast-discovery-server", "-i", "0", "-l", "127.0.0.1",
+                                 "-p", std::to_string(port), "-x",
+                                 "usv_fdi_discovery_server_udp@" + xml()},
+        d.dir + "/" + tag + "_server.log");
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    ::setenv("ROS_DISCOVERY_SERVER", ("127.0.0.1:" + std::to_string(port)).c_str(), 1);
+    ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", xml().c_str(), 1);
+  }
+  ~FleetDiscovery() { clear_env(); }
+  FleetDiscovery(const FleetDiscovery&) = delete;
+  FleetDiscovery& operator=(const FleetDiscovery&) = delete;
+  std::vector<std::string> args() const {
+    return {"--domain",
+            std::to_string(d_.o.domain),
+            "--qos",
+            d_.o.profiles,
+            "--participant-profile",
+            "usv_fdi_fleet_udp",
+            "--partition",
+            partition_};
+  }
+
+ private:
+  static std::string xml() {
+    return std::string(USV_FDI_SOURCE_DIR) + "/docker/fleet_participants.xml";
+  }
+  static void clear_env() {
+    ::unsetenv("ROS_DISCOVERY_SERVER");
+    ::unsetenv("FASTRTPS_DEFAULT_PROFILES_FILE");
+  }
+  const Driver& d_;
+  std::string partition_;
+  std::unique_ptr<Child> server_;
+};
+
 int run_shore_one(const Driver& d, int vessels, int participants, int port) {
   const Options& o = d.o;
-  const std::string fleet_xml = std::string(USV_FDI_SOURCE_DIR) + "/docker/fleet_participants.xml";
   const std::string tag = "shore" + std::to_string(vessels);
-  // The server must not see ROS_DISCOVERY_SERVER (the 2.9 server then aborts); its clients must.
-  ::unsetenv("ROS_DISCOVERY_SERVER");
-  ::unsetenv("FASTRTPS_DEFAULT_PROFILES_FILE");
-  Child server({"/usr/bin/fast-discovery-server", "-i", "0", "-l", "127.0.0.1", "-p",
-                std::to_string(port), "-x", "usv_fdi_discovery_server_udp@" + fleet_xml},
-               d.dir + "/" + tag + "_server.log");
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  ::setenv("ROS_DISCOVERY_SERVER", ("127.0.0.1:" + std::to_string(port)).c_str(), 1);
-  ::setenv("FASTRTPS_DEFAULT_PROFILES_FILE", fleet_xml.c_str(), 1);
-  const std::vector<std::string> dds_args = {
-      "--domain",    std::to_string(o.domain), "--qos",
-      o.profiles,    "--participant-profile",  "usv_fdi_fleet_udp",
-      "--partition", "bench_shore_" + d.tag};
+  FleetDiscovery fleet(d, tag, port, "bench_shore_" + d.tag);
+  const std::vector<std::string> dds_args = fleet.args();
   std::vector<std::string> mon = {USV_FDI_EXE, "monitor", "--json", "--status"};
   mon.insert(mon.end(), dds_args.begin(), dds_args.end());
   const std::string mon_out = d.dir + "/" + tag + "_monitor.jsonl";
@@ -888,8 +923,6 @@ int run_shore_one(const Driver& d, int vessels, int participants, int port) {
   emu.insert(emu.end(), dds_args.begin(), dds_args.end());
   const auto t_start = Clock::now();
   Child emulator(emu, d.dir + "/" + tag + "_emulate.log");
-  ::unsetenv("ROS_DISCOVERY_SERVER");
-  ::unsetenv("FASTRTPS_DEFAULT_PROFILES_FILE");
   LineTail tail(mon_out);
   std::set<std::uint32_t> seen;
   double discovery_s = NAN;
@@ -933,6 +966,28 @@ int run_shore_one(const Driver& d, int vessels, int participants, int port) {
   return 0;
 }
 
+/// Part 4: the shore at fleet scale, through a discovery server.
+int run_shore(const Driver& d) {
+  std::printf(
+      "\n4. Shore at fleet scale: usv-fdi monitor --json --status and usv-fdi emulate, both "
+      "clients of a\n   discovery server on 127.0.0.1 (docker/fleet_participants.xml); %g s "
+      "measured once every vessel is shown\n",
+      d.o.shore_seconds);
+  std::printf("   %10s %9s %7s %9s %9s %9s %8s %8s %8s %7s %9s\n", "vessels/DP", "shown [s]",
+              "shown", "mon CPU%", "RSS [MB]", "HWM [MB]", "ev p50", "ev p99", "ev max", "events",
+              "emu CPU%");
+  std::printf("   %10s %9s %7s %9s %9s %9s %8s %8s %8s %7s %9s\n", "", "", "", "", "", "", "[ms]",
+              "[ms]", "[ms]", "", "");
+  int port = 12811 + static_cast<int>(::getpid() % 1000);
+  for (std::size_t i = 0; i < d.o.shore_vessels.size(); ++i) {
+    if (run_shore_one(d, d.o.shore_vessels[i], d.o.shore_participants[i], port++) != 0) return 1;
+  }
+  std::printf(
+      "   targets at 1000 vessels: monitor < 100 %% of a core and < 200 MB, event p99 < 50 ms, "
+      "every vessel shown within 10 s\n");
+  return 0;
+}
+
 /// Part 5 for one fleet size and filter setting: the sidecars' summed CPU [s] over the window.
 struct FanoutRun {
   double cpu_per_sidecar = 0.0;  ///< [% of a core]
@@ -940,10 +995,15 @@ struct FanoutRun {
   double sim_cpu = 0.0;          ///< [% of a core]
 };
 
-bool run_fanout_one(const Driver& d, int n, bool filter, FanoutRun* out) {
+bool run_fanout_one(const Driver& d, int n, bool filter, int port, FanoutRun* out) {
   const Options& o = d.o;
-  const std::string part = "bench_fanout_" + d.tag;
   const std::string tag = "fanout" + std::to_string(n) + (filter ? "f" : "n");
+  FleetDiscovery fleet(d, tag, port, "bench_fanout_" + d.tag);
+  const std::vector<std::string> dds_args = fleet.args();
+  auto with_dds = [&dds_args](std::vector<std::string> head) {
+    head.insert(head.end(), dds_args.begin(), dds_args.end());
+    return head;
+  };
   std::vector<std::unique_ptr<Child>> sidecars;
   std::vector<std::string> sim = {USV_FDI_EXE,
                                   "sim",
@@ -967,8 +1027,8 @@ bool run_fanout_one(const Driver& d, int n, bool filter, FanoutRun* out) {
         write_service_config(d.dir, name, false, mmsi,
                              std::string("  content_filter: ") + (filter ? "true" : "false") +
                                  "\n  input_timeout: 60\n");
-    sidecars.push_back(std::make_unique<Child>(
-        d.command({USV_FDI_EXE, "run", "--config", cfg}, part), d.dir + "/" + name + ".log"));
+    sidecars.push_back(std::make_unique<Child>(with_dds({USV_FDI_EXE, "run", "--config", cfg}),
+                                               d.dir + "/" + name + ".log"));
     sim.push_back("--mmsi");
     sim.push_back(std::to_string(mmsi));
   }
@@ -979,7 +1039,12 @@ bool run_fanout_one(const Driver& d, int n, bool filter, FanoutRun* out) {
       return false;
     }
   }
-  Child publisher(d.command(sim, part), d.dir + "/" + tag + "_sim.log");
+  Child publisher(with_dds(sim), d.dir + "/" + tag + "_sim.log");
+  // Measured once the simulator publishes (every sidecar's readers matched) and 5 s on.
+  if (!wait_for_text(d.dir + "/" + tag + "_sim.log", "publishing", 60)) {
+    std::fprintf(stderr, "the simulator did not start publishing; see %s\n", d.dir.c_str());
+    return false;
+  }
   std::this_thread::sleep_for(std::chrono::seconds(5));
   std::vector<ProcUsage> u0;
   for (const auto& c : sidecars) u0.push_back(usage(c->pid()));
@@ -1001,41 +1066,23 @@ bool run_fanout_one(const Driver& d, int n, bool filter, FanoutRun* out) {
 int run_fanout(const Driver& d) {
   std::printf(
       "\n5. Input fan-out: N sidecars and one sim --publish of N vessels at 10 Hz on one "
-      "partition; CPU over %g s\n",
+      "partition,\n   clients of a discovery server on 127.0.0.1; CPU over %g s once the "
+      "voyage is published\n",
       d.o.fanout_seconds);
   std::printf("   %8s %22s %22s %18s\n", "", "content_filter: false", "content_filter: true",
               "sim --publish [%]");
   std::printf("   %8s %11s %10s %11s %10s %9s %8s\n", "sidecars", "per sidecar", "fleet",
               "per sidecar", "fleet", "false", "true");
+  int port = 13811 + static_cast<int>(::getpid() % 1000);
   for (int n : d.o.fanout_sidecars) {
     FanoutRun off, on;
-    if (!run_fanout_one(d, n, false, &off) || !run_fanout_one(d, n, true, &on)) return 1;
+    if (!run_fanout_one(d, n, false, port++, &off) || !run_fanout_one(d, n, true, port++, &on)) {
+      return 1;
+    }
     std::printf("   %8d %10.2f%% %9.1f%% %10.2f%% %9.1f%% %9.1f %8.1f\n", n, off.cpu_per_sidecar,
                 off.fleet_total, on.cpu_per_sidecar, on.fleet_total, off.sim_cpu, on.sim_cpu);
     std::fflush(stdout);
   }
-  return 0;
-}
-
-/// Part 4: the shore at fleet scale, through a discovery server.
-int run_shore(const Driver& d) {
-  std::printf(
-      "\n4. Shore at fleet scale: usv-fdi monitor --json --status and usv-fdi emulate, both "
-      "clients of a\n   discovery server on 127.0.0.1 (docker/fleet_participants.xml); %g s "
-      "measured once every vessel is shown\n",
-      d.o.shore_seconds);
-  std::printf("   %10s %9s %7s %9s %9s %9s %8s %8s %8s %7s %9s\n", "vessels/DP", "shown [s]",
-              "shown", "mon CPU%", "RSS [MB]", "HWM [MB]", "ev p50", "ev p99", "ev max", "events",
-              "emu CPU%");
-  std::printf("   %10s %9s %7s %9s %9s %9s %8s %8s %8s %7s %9s\n", "", "", "", "", "", "", "[ms]",
-              "[ms]", "[ms]", "", "");
-  int port = 12811 + static_cast<int>(::getpid() % 1000);
-  for (std::size_t i = 0; i < d.o.shore_vessels.size(); ++i) {
-    if (run_shore_one(d, d.o.shore_vessels[i], d.o.shore_participants[i], port++) != 0) return 1;
-  }
-  std::printf(
-      "   targets at 1000 vessels: monitor < 100 %% of a core and < 200 MB, event p99 < 50 ms, "
-      "every vessel shown within 10 s\n");
   return 0;
 }
 
