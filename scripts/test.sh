@@ -18,7 +18,7 @@ ctest --test-dir "${BUILD_DIR:-build}" --output-on-failure -j 2 --timeout 1500 |
 # Only what the service's tests need is built with a sanitizer (Fast DDS itself is not
 # instrumented; see tests/sanitizers/ for the runtime options and suppressions).
 san_targets=(usv_fdi_pipeline_tests usv_fdi_service_tests usv_fdi_service_e2e_tests
-             usv_fdi_nmea_udp_e2e_tests usv-fdi)
+             usv_fdi_nmea_udp_e2e_tests usv_fdi_ros2_e2e_tests usv-fdi)
 for san in ${USV_FDI_SANITIZERS-thread address}; do
   case "$san" in
     thread) dir=build-tsan ;;
