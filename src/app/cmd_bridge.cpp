@@ -26,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "ack_protocol.hpp"
@@ -163,9 +164,11 @@ class Bridge {
   /// An ALF for every instance whose sequence or state changed since the last one sent.
   void send_changes() {
     for (const Row& r : rows()) {
+      // The incarnation too: a sidecar restarted without its state raises #1 again.
       auto& last = shown_[static_cast<int>(r.ev.sensor)];
-      if (last.first == r.ev.sequence && last.second == r.ev.state) continue;
-      last = {r.ev.sequence, r.ev.state};
+      const auto now = std::make_tuple(r.ev.incarnation, r.ev.sequence, r.ev.state);
+      if (last == now) continue;
+      last = now;
       spdlog::info("bridge: ALF {} {} revision {} ({} #{})", to_string(r.ev.sensor),
                    static_cast<char>(alert_state(r.ev.state)), alert_revision(r.ev.sequence),
                    to_string(r.ev.state), r.ev.sequence);
@@ -266,6 +269,13 @@ class Bridge {
       case AcnAction::kAcknowledge:
         break;
     }
+    for (const PendingAck& p : pending_) {
+      if (p.req.sensor == act.ack.sensor && p.req.sequence == act.ack.sequence) {
+        spdlog::info("bridge: ACN for {} #{} repeated while its acknowledgement is pending",
+                     to_string(act.ack.sensor), act.ack.sequence);
+        return;  // one FaultAck, one answer
+      }
+    }
     fdds::PublicationMatchedStatus st;
     ack_writer_->get_publication_matched_status(st);
     if (st.current_count == 0) {
@@ -310,7 +320,7 @@ class Bridge {
   std::unique_ptr<nmea_udp::NmeaUdpSender> tx_;
   std::unique_ptr<nmea_udp::UdpListener> rx_;
   fdds::DataWriter* ack_writer_ = nullptr;
-  std::map<int, std::pair<std::uint64_t, FaultState>> shown_;
+  std::map<int, std::tuple<std::uint64_t, std::uint64_t, FaultState>> shown_;
   std::vector<PendingAck> pending_;
   Rejections rejections_;
   Clock::time_point next_alc_ = Clock::now(), next_hbt_ = Clock::now();

@@ -37,6 +37,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "commands.hpp"
@@ -419,8 +420,13 @@ class Adapter {
 
   void diagnostics() {
     const double age = view_.heard_age(a_.mmsi);
+    std::uint32_t input_flags = 0;
+    if (const auto* vessels = view_.vessels()) {
+      const VesselStatus* v = vessels->shown(a_.mmsi);
+      if (v != nullptr) input_flags = v->st.input_flags();
+    }
     auto statuses = ros2::vessel_diagnostics(
-        a_.mmsi, [&](Sensor s) { return row_of(s); }, age, a_.silent_after);
+        a_.mmsi, [&](Sensor s) { return row_of(s); }, age, a_.silent_after, input_flags);
     const auto now = Clock::now();
     if (statuses == last_diag_ && now < next_diag_) return;
     for (const auto& st : statuses) {
@@ -459,9 +465,11 @@ class Adapter {
     if (ros_.fault_event == nullptr) return;
     view_.rows().for_each([&](const RowKey& key, const Row& r) {
       if (key.first != a_.mmsi) return;
+      // The incarnation too: a sidecar restarted without its state raises #1 again.
       auto& last = mirrored_[key.second];
-      if (last.first == r.ev.sequence && last.second == r.ev.state) return;
-      last = {r.ev.sequence, r.ev.state};
+      const auto now = std::make_tuple(r.ev.incarnation, r.ev.sequence, r.ev.state);
+      if (last == now) return;
+      last = now;
       auto m = mirror_of(r);
       ros_.fault_event->write(&m);
     });
@@ -489,7 +497,7 @@ class Adapter {
   std::vector<ros2::DiagStatus> last_diag_;
   std::map<std::string, ros2::DiagLevel> last_levels_;
   Clock::time_point next_diag_ = Clock::now();
-  std::map<int, std::pair<std::uint64_t, FaultState>> mirrored_;
+  std::map<int, std::tuple<std::uint64_t, std::uint64_t, FaultState>> mirrored_;
   double last_status_stamp_ = std::nan("");
 };
 

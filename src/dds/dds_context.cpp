@@ -209,7 +209,13 @@ fdds::DataWriter& DdsContext::create_writer_in_partitions(
   fdds::Publisher* pub = participant_->create_publisher(qos);  // deleted with the participant
   if (pub == nullptr) fail("creating a publisher for topic '" + topic(id).get_name() + "' failed");
   fdds::Topic* t = topics_[index_of(id)];
-  fdds::DataWriter* writer = pub->create_datawriter_with_profile(t, profile);
+  fdds::DataWriter* writer = nullptr;
+  fdds::DataWriterQos qos_w;
+  if (pub->get_datawriter_qos_from_profile(profile, qos_w) == ReturnCode_t::RETCODE_OK) {
+    qos_w.writer_resource_limits().reader_filters_allocation =
+        eprosima::fastrtps::ResourceLimitedContainerConfig(0u, kMaxReaderFilters, 1u);
+    writer = pub->create_datawriter(t, qos_w);
+  }
   if (writer == nullptr) {
     std::string in;
     for (const auto& p : partitions) in += (in.empty() ? "" : ", ") + p;
