@@ -50,9 +50,9 @@ struct ServiceConfig {
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
 ///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
 ///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
-///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level, authorised_operators: [..],
-///   input_queue, rudder_wait, rudder_timeout, input_timeout, restore_recheck,
-///   state_dir (relative to the config file; "" : no persistence), health_file,
+///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level,
+///   authorised_operators: [..], input_queue, rudder_wait, rudder_timeout, input_timeout,
+///   restore_recheck, state_dir (relative to the config file; "" : no persistence), health_file,
 ///   input (dds | nmea), nmea: {address, port, interface, rate, max_age, receive_buffer}.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
 /// Throws usvfdi::io::ConfigError naming file, key, line and value.
