@@ -420,13 +420,10 @@ class Adapter {
 
   void diagnostics() {
     const double age = view_.heard_age(a_.mmsi);
-    std::uint32_t input_flags = 0;
-    if (const auto* vessels = view_.vessels()) {
-      const VesselStatus* v = vessels->shown(a_.mmsi);
-      if (v != nullptr) input_flags = v->st.input_flags();
-    }
+    // The age in the STALE message is in whole seconds, so that a silent sidecar does not make
+    // every turn a change (at most one a second, the period).
     auto statuses = ros2::vessel_diagnostics(
-        a_.mmsi, [&](Sensor s) { return row_of(s); }, age, a_.silent_after, input_flags);
+        a_.mmsi, [&](Sensor s) { return row_of(s); }, age, a_.silent_after);
     const auto now = Clock::now();
     if (statuses == last_diag_ && now < next_diag_) return;
     for (const auto& st : statuses) {

@@ -120,26 +120,8 @@ const char* to_string(DiagLevel l) {
   return "?";
 }
 
-std::string stale_input(Sensor sensor, std::uint32_t input_flags) {
-  std::string why;
-  auto add = [&why, input_flags](std::uint32_t flag, const char* text) {
-    if ((input_flags & flag) != 0) why += (why.empty() ? "" : "; ") + std::string(text);
-  };
-  add(fdi::INPUT_INS_SILENT, "no INS sample");
-  add(fdi::INPUT_RUDDER_MISSING, "no usable rudder angle (detection paused)");
-  if (sensor == Sensor::kAccelerometer) {
-    add(fdi::INPUT_ACCELEROMETER_UNUSABLE, "accelerometer channel stale, invalid or stuck");
-  }
-  if (sensor == Sensor::kGyro)
-    add(fdi::INPUT_GYRO_UNUSABLE, "gyro channel stale, invalid or stuck");
-  return why;
-}
-
-DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after,
-                           std::uint32_t input_flags) {
+DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after) {
   if (!(heard_age <= silent_after)) return DiagLevel::kStale;  // NaN: never heard
-  const bool raised = row != nullptr && row->ev.state == FaultState::kRaised;
-  if (!raised && !stale_input(sensor, input_flags).empty()) return DiagLevel::kStale;
   if (row == nullptr) return DiagLevel::kOk;
   DiagLevel l = DiagLevel::kOk;
   switch (row->ev.state) {
@@ -160,21 +142,18 @@ DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, doub
 }
 
 DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,
-                               double silent_after, std::uint32_t input_flags) {
+                               double silent_after) {
   DiagStatus d;
-  d.level = diagnostic_level(sensor, row, heard_age, silent_after, input_flags);
+  d.level = diagnostic_level(sensor, row, heard_age, silent_after);
   d.name = fmt::format("usv_fdi: {} {}", mmsi, to_string(sensor));
   d.hardware_id = std::to_string(mmsi);
   if (std::isnan(heard_age)) {
     d.message = "the vessel's usv-fdi sidecar has not been heard";
-  } else if (!(heard_age <= silent_after)) {
+  } else if (d.level == DiagLevel::kStale) {
     d.message = fmt::format(
         "the vessel's usv-fdi sidecar has not been heard for {:.0f} s; last "
         "known state: {}",
         heard_age, row == nullptr ? "no fault" : to_string(row->ev.state));
-  } else if (d.level == DiagLevel::kStale) {
-    d.message = "input stale: " + stale_input(sensor, input_flags) +
-                "; last known state: " + (row == nullptr ? "no fault" : to_string(row->ev.state));
   } else if (row == nullptr) {
     d.message = "no fault";
   } else {

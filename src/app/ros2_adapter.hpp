@@ -135,16 +135,11 @@ struct DiagStatus {
 };
 
 /// The level of one fault instance: STALE when the vessel's sidecar has not been heard for
-/// more than silent_after s (heard_age NaN: never heard); ERROR when raised; STALE when the
-/// sensor's input is (input_flags, the vessel's FdiStatus.input_flags: no INS sample, no usable
-/// rudder angle, or the sensor's channel stale, invalid or stuck); else by the latch state:
-/// active-acknowledged or cleared-unacknowledged -> WARN; normal or acknowledged -> OK.
+/// more than silent_after s (heard_age NaN: never heard); else by the latch state: raised ->
+/// ERROR; active-acknowledged or cleared-unacknowledged -> WARN; normal or acknowledged -> OK.
 /// An instance of the unknown sensor (a fault no sensor could be blamed for) is at most WARN.
 /// `row` nullptr: no instance published (OK).
-DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after,
-                           std::uint32_t input_flags = 0);
-/// What of input_flags makes the sensor's input stale, in words ("" : nothing).
-std::string stale_input(Sensor sensor, std::uint32_t input_flags);
+DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after);
 
 /// The statuses of one vessel: "usv_fdi: <mmsi> accelerometer" and "... gyro" always,
 /// "... unknown" once the sidecar has published that instance. hardware_id is the MMSI;
@@ -152,19 +147,19 @@ std::string stale_input(Sensor sensor, std::uint32_t input_flags);
 /// `row_of(sensor)` gives the vessel's instance of a sensor or nullptr.
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
-                                           double silent_after, std::uint32_t input_flags = 0);
+                                           double silent_after);
 
 DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,
-                               double silent_after, std::uint32_t input_flags = 0);
+                               double silent_after);
 
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
-                                           double silent_after, std::uint32_t input_flags) {
+                                           double silent_after) {
   std::vector<DiagStatus> out;
   for (const Sensor s : {Sensor::kAccelerometer, Sensor::kGyro, Sensor::kUnknown}) {
     const Row* row = row_of(s);
     if (s == Sensor::kUnknown && row == nullptr) continue;
-    out.push_back(instance_diagnostic(mmsi, s, row, heard_age, silent_after, input_flags));
+    out.push_back(instance_diagnostic(mmsi, s, row, heard_age, silent_after));
   }
   return out;
 }

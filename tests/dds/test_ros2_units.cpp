@@ -176,23 +176,6 @@ TEST(Ros2Diagnostics, ASilentOrNeverHeardSidecarIsStale) {
   EXPECT_EQ(diagnostic_level(Sensor::kGyro, &raised, 5.0, 5.0), DiagLevel::kError);
 }
 
-TEST(Ros2Diagnostics, AStaleInputIsStaleUnlessItsFaultIsRaised) {
-  const Row cleared = row(Sensor::kGyro, FaultState::kClearedUnacknowledged);
-  const Row raised = row(Sensor::kGyro, FaultState::kRaised);
-  const std::uint32_t gyro = fdi::INPUT_GYRO_UNUSABLE, ins = fdi::INPUT_INS_SILENT,
-                      rudder = fdi::INPUT_RUDDER_MISSING;
-  // The gyro's own channel, no INS at all, no rudder angle: the gyro's status is stale
-  EXPECT_EQ(diagnostic_level(Sensor::kGyro, nullptr, 0.1, 5.0, gyro), DiagLevel::kStale);
-  EXPECT_EQ(diagnostic_level(Sensor::kGyro, &cleared, 0.1, 5.0, ins), DiagLevel::kStale);
-  EXPECT_EQ(diagnostic_level(Sensor::kGyro, nullptr, 0.1, 5.0, rudder), DiagLevel::kStale);
-  // the accelerometer's status does not go stale for the gyro's channel
-  EXPECT_EQ(diagnostic_level(Sensor::kAccelerometer, nullptr, 0.1, 5.0, gyro), DiagLevel::kOk);
-  // a raised fault stays an error
-  EXPECT_EQ(diagnostic_level(Sensor::kGyro, &raised, 0.1, 5.0, gyro), DiagLevel::kError);
-  const DiagStatus d = instance_diagnostic(257000001, Sensor::kGyro, nullptr, 0.1, 5.0, gyro);
-  EXPECT_NE(d.message.find("gyro channel stale"), std::string::npos) << d.message;
-}
-
 TEST(Ros2Diagnostics, OneStatusPerSensorNamedByVesselWithTheEventsValues) {
   const Row g = row(Sensor::kGyro, FaultState::kRaised);
   const auto st = vessel_diagnostics(
