@@ -82,6 +82,10 @@ void IsolationParams::validate() const {
   require(classify_window > 0, "classify_window", classify_window, "must be > 0");
   require(history_margin >= 1, "history_margin", history_margin, "must be >= 1");
   require(history >= 10, "history", history, "must be >= 10 s");
+  require(drift_k > 0, "drift_k", drift_k, "must be > 0");
+  require(drift_threshold > 0, "drift_threshold", drift_threshold, "must be > 0");
+  require(drift_lag >= 0, "drift_lag", drift_lag, "must be >= 0");
+  require(drift_min_history >= 0, "drift_min_history", drift_min_history, "must be >= 0");
   jump.validate();
 }
 
@@ -115,7 +119,8 @@ Isolator::Isolator(const IsolationParams& params, const Vec2& B, const SpeedPara
       checks_(p_),
       jump_{JumpCheck(p_.jump, B_(0), p_.sigma_floor_v),
             JumpCheck(p_.jump, B_(1), p_.sigma_floor_r)},
-      healthy_(10.0, p_.history) {
+      healthy_(10.0, p_.history),
+      drift_healthy_(10.0, p_.history) {
   scales_configured_ = p_.sigma_v > 0;
   const double pmin = std::min(p_.poles_v.cwiseAbs().minCoeff(), p_.poles_g.cwiseAbs().minCoeff());
   settle_time_ = p_.settle_time >= 0 ? p_.settle_time : 3.0 / pmin;
@@ -181,7 +186,10 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   if (faulty) t_last_fault_ = s.t;
   if (st_.armed && !st_.learning && !st_.settling) {
     suspect = suspect || (st_.J.array() > p_.exit_ratio * st_.thresholds.array()).any() ||
-              (st_.D.array() > p_.exit_ratio * st_.thresholds_d.array()).any();
+              (st_.D.array() > p_.exit_ratio * st_.thresholds_d.array()).any() ||
+              (st_.drift_S.array() > p_.exit_ratio * st_.drift_threshold.array() &&
+               st_.drift_threshold.array() > 0)
+                  .any();
   }
   if (suspect) t_last_suspect_ = s.t;
   freeze_ = s.t - t_last_suspect_ < p_.resume_time || s.t - t_last_fault_ < p_.resume_after_fault;
@@ -371,6 +379,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   const Levels lv = levels(s.t, dt);
   const Candidate c = choose_candidate(s.t, lv);
   confirm_candidate(s.t, lv, c, out);
+  drift_checks(s.t, dt, x, learn_ok, lv, out);
   refine_kinds(s.t, out);
   hold_or_clear(s.t, lv, c.k, out);
 }

@@ -15,6 +15,7 @@
 
 namespace usvfdi {
 
+using isolation_detail::channel_sensor;
 using isolation_detail::kEpsT;
 using isolation_detail::sensor_index;
 
@@ -45,6 +46,7 @@ void Isolator::set_condition(Sensor sensor, Source src, bool on, FaultKind kind,
   c.sources = on ? (c.sources | src) : (c.sources & ~src);
   if (before == 0 && c.sources != 0) {
     pending_stats_.clear();  // the samples before a raise are not healthy
+    pending_drift_.clear();
     c.active = true;
     c.kind = kind;
     if (sensor != Sensor::kUnknown) start_monitor(sensor_index(sensor));
@@ -215,6 +217,7 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
                                       : "");
       st_.model_mismatch = true;
       pending_stats_.clear();
+      pending_drift_.clear();
       st_.mismatch_reason = buf;
       ++st_.mismatches;
       mismatch_since_ = t;
@@ -274,6 +277,87 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
       sens_[k].below_since = kNaN;
     }
   }
+}
+
+void Isolator::reset_drift() {
+  drift_hi_.fill(0.0);
+  drift_lo_.fill(0.0);
+  st_.drift_S = Vec2::Zero();
+}
+
+void Isolator::drift_checks(double t, double dt, const Statistics& x, bool learn_ok,
+                            const Levels& lv, std::vector<Detection>* out) {
+  // The CUSUMs run while nothing is raised, the model holds and the observers are live;
+  // anything else starts them again from zero (a fault's evidence was used by its raise,
+  // and a model mismatch is not a drift).
+  bool any = false;
+  for (const SensorState& x_s : sens_) any = any || x_s.cond.active;
+  const bool run = p_.drift_check && model_live() && !any && !st_.model_mismatch &&
+                   t - t_last_fault_ >= p_.resume_after_fault && dt > 0 && dt <= p_.stale_timeout &&
+                   !(t < chan_[0].resettle_until) && !(t < chan_[1].resettle_until) &&
+                   x.sw.allFinite();
+  st_.drift_threshold = Vec2::Zero();
+  if (!run) {
+    reset_drift();
+    pending_drift_.clear();
+    return;
+  }
+  double S[2];
+  for (int c = 0; c < 2; ++c) {
+    const double w = std::max(-p_.clip, std::min(x.sw(c), p_.clip));
+    drift_hi_[c] = std::max(0.0, drift_hi_[c] + (w - p_.drift_k) * dt);
+    drift_lo_[c] = std::max(0.0, drift_lo_[c] + (-w - p_.drift_k) * dt);
+    if (drift_hi_[c] == 0.0) drift_from_hi_[c] = t;
+    if (drift_lo_[c] == 0.0) drift_from_lo_[c] = t;
+    S[c] = std::max(drift_hi_[c], drift_lo_[c]);
+  }
+  st_.drift_S = Vec2(S[0], S[1]);
+  // Healthy maxima from values drift_lag old: a drift's own rise stays out of its bar.
+  pending_drift_.push_back(PendingDrift{t, {S[0], S[1]}, learn_ok});
+  while (!pending_drift_.empty() && t - pending_drift_.front().t > p_.drift_lag) {
+    if (pending_drift_.front().ok) {
+      drift_healthy_.add(pending_drift_.front().t, pending_drift_.front().x);
+    }
+    pending_drift_.pop_front();
+  }
+  if (drift_healthy_.empty() || drift_healthy_.covered() < p_.drift_min_history) return;
+  Vec2 ratio;
+  for (int c = 0; c < 2; ++c) {
+    st_.drift_threshold(c) =
+        std::max(p_.drift_threshold, p_.history_margin * drift_healthy_.extrapolated_max(c));
+    ratio(c) = S[c] / st_.drift_threshold(c);
+  }
+  const int c = ratio(0) >= ratio(1) ? 0 : 1;
+  // Channel j (the other) is blind to a fault of sensor c: its CUSUM and J_N stay quiet.
+  if (!(ratio(c) > 1.0) || ratio(1 - c) > p_.exit_ratio || lv.ratio(1 - c) > p_.exit_ratio) {
+    return;
+  }
+  const Vec2 e = ratio.cwiseSqrt();
+  const double ca = e(0) / e.norm(), cg = e(1) / e.norm();
+  const double ci = c == 0 ? ca : cg, co = c == 0 ? cg : ca;
+  if (ci < p_.c_min || ci - co < p_.c_margin) return;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s channel drifts: CUSUM %.3g > %.3g (the other channel %.3g)",
+                c == 0 ? "accelerometer" : "gyro", S[c], st_.drift_threshold(c), S[1 - c]);
+  const std::size_t before = out->size();
+  // The kind from the residuals' shape like any residual raise (a scale error on a slowly
+  // turning vessel, or a small offset, also pile up in the CUSUM), refined later.
+  const FaultKind kind = classify(c);
+  set_condition(channel_sensor(c), kResidual, true,
+                kind == FaultKind::kUnknown ? FaultKind::kDrift : kind, t, buf, out);
+  if (out->size() > before && out->back().active) {
+    Detection& d = out->back();
+    d.statistic = S[c];
+    d.threshold = st_.drift_threshold(c);
+    d.c_a = ca;
+    d.c_g = cg;
+    // The onset: when the side of the CUSUM that raised last left zero.
+    d.onset_time = drift_hi_[c] >= drift_lo_[c] ? drift_from_hi_[c] : drift_from_lo_[c];
+  }
+  sens_[c].raised_at = t;
+  sens_[c].below_since = kNaN;
+  chan_[c].refine_at = t + 0.5 * p_.classify_window;
+  reset_drift();
 }
 
 FaultKind Isolator::classify(int ch) const {

@@ -338,6 +338,11 @@ class Loader {
         {"spike_count", integer_into(&is->spike_count, {1, 1000000, ""})},
         {"invalid_count", integer_into(&is->invalid_count, {1, 1000000, ""})},
         {"classify_window", number_into(&is->classify_window, {0, kHour, "s"})},
+        {"drift_check", boolean_into(&is->drift_check)},
+        {"drift_k", number_into(&is->drift_k, {0, 100, "(whitened)"})},
+        {"drift_threshold", number_into(&is->drift_threshold, {0, 1e6, "(whitened x s)"})},
+        {"drift_lag", number_into(&is->drift_lag, {0, kHour, "s"})},
+        {"drift_min_history", number_into(&is->drift_min_history, {0, 24 * kHour, "s"})},
     };
   }
 

@@ -124,6 +124,11 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.spike_count, q.spike_count);
   EXPECT_EQ(p.invalid_count, q.invalid_count);
   EXPECT_EQ(p.classify_window, q.classify_window);
+  EXPECT_EQ(p.drift_check, q.drift_check);
+  EXPECT_EQ(p.drift_k, q.drift_k);
+  EXPECT_EQ(p.drift_threshold, q.drift_threshold);
+  EXPECT_EQ(p.drift_lag, q.drift_lag);
+  EXPECT_EQ(p.drift_min_history, q.drift_min_history);
 }
 
 TEST(Config, OnlyModelBGivesTheCoreDefaults) {
@@ -201,6 +206,9 @@ isolation:
   stuck_time_max: 4
   spike_count: 5
   classify_window: 9
+  drift_check: false
+  drift_k: 0.25
+  drift_lag: 30
   history_margin: 2.5
   history: 1200
   second_fault_time: 3.5
@@ -228,6 +236,9 @@ service:
   EXPECT_EQ(c.isolation.poles_g, Vec2(-3, -4));
   EXPECT_EQ(c.isolation.stuck_min_samples, 7);
   EXPECT_EQ(c.isolation.classify_window, 9.0);
+  EXPECT_FALSE(c.isolation.drift_check);
+  EXPECT_EQ(c.isolation.drift_k, 0.25);
+  EXPECT_EQ(c.isolation.drift_lag, 30.0);
   EXPECT_EQ(c.isolation.history_margin, 2.5);
   EXPECT_EQ(c.isolation.history, 1200.0);
   EXPECT_FALSE(c.identification.cubic_correction);

@@ -104,6 +104,25 @@ struct IsolationParams {
   int spike_count = 3;             ///< this many spikes in the window raise a spikes fault
   int invalid_count = 3;           ///< this many invalid values in spike_window raise invalid
   double classify_window = 8.0;    ///< history used to name the kind of a fault [s]
+  /// The drift test (issue 11, item 6). A slow fault of sensor i is absorbed by its own
+  /// structured residual s_i, which keeps a part of it (det(A) / (p1 p2) of a constant one),
+  /// too little for J_N's window but steady; s_j, blind to sensor i, keeps none. Per channel
+  /// a two-sided CUSUM of the whitened structured residual w, integrated over time,
+  ///   S+ = max(0, S+ + (w - drift_k) dt),  S- = max(0, S- + (-w - drift_k) dt),
+  /// raises a drift of sensor i when max(S+, S-) of channel i passes its threshold while
+  /// channel j's stays below exit_ratio x its own and J_N of channel j below its leave
+  /// threshold; C_i is the paper's on [sqrt(S_a / thr_a), sqrt(S_g / thr_g)]. Each threshold
+  /// is max(drift_threshold, history_margin x the largest value the CUSUM took on healthy
+  /// data over `history`), learned from values once they are drift_lag old (a drift grows
+  /// for tens of seconds before it is raised). Off by default: with the default poles a
+  /// ship's structured residual keeps 0.3 % of a slow fault, nothing to see, while the
+  /// CUSUM integrates every slow disturbance (docs/benchmark.md); on for observers whose
+  /// poles are slow relative to the hull's (the shipped vessel configurations).
+  bool drift_check = false;
+  double drift_k = 0.5;              ///< the CUSUM's reference offset [whitened units]
+  double drift_threshold = 5.0;      ///< floor of its threshold [whitened units x s]
+  double drift_lag = 40.0;           ///< its healthy maximum learns from values this old [s]
+  double drift_min_history = 120.0;  ///< healthy time seen before it may raise [s]
   /// The model-free jump check of each channel (core/jump_check.hpp): sudden offsets and
   /// noise rises, armed after its learn_time whether or not A is known.
   JumpParams jump;
@@ -157,6 +176,10 @@ struct IsolatorStatus {
   bool jump_armed = false;
   Vec2 jump_T = Vec2::Zero(), jump_threshold = Vec2::Zero();    ///< step statistic
   Vec2 noise_N = Vec2::Zero(), noise_threshold = Vec2::Zero();  ///< noise statistic
+  /// The drift test (IsolationParams::drift_k) per channel [accelerometer, gyro]: the CUSUM
+  /// of the whitened structured residual [whitened units x s] and its threshold (0 while it
+  /// cannot raise).
+  Vec2 drift_S = Vec2::Zero(), drift_threshold = Vec2::Zero();
 };
 
 class Isolator {
@@ -342,6 +365,10 @@ class Isolator {
                          std::vector<Detection>* out);
   void refine_kinds(double t, std::vector<Detection>* out);
   void hold_or_clear(double t, const Levels& lv, int candidate, std::vector<Detection>* out);
+  /// The drift test of both channels on one sample (IsolationParams::drift_k).
+  void drift_checks(double t, double dt, const Statistics& x, bool learn_ok, const Levels& lv,
+                    std::vector<Detection>* out);
+  void reset_drift();
   /// The fault kind of a channel from its histories (core/fault_kind.hpp).
   FaultKind classify(int ch) const;
   std::size_t window_samples(double dt) const;
@@ -381,6 +408,17 @@ class Isolator {
     bool ok;
   };
   std::deque<PendingStat> pending_stats_;
+  // The drift test: its CUSUMs per channel (high and low side, and when each side last was
+  // 0), and their healthy maxima, learned from values drift_lag old.
+  std::array<double, 2> drift_hi_{}, drift_lo_{};
+  std::array<double, 2> drift_from_hi_{}, drift_from_lo_{};
+  HealthyMaxima<2> drift_healthy_;
+  struct PendingDrift {
+    double t;
+    double x[2];
+    bool ok;
+  };
+  std::deque<PendingDrift> pending_drift_;
   double history_lag() const;
   double last_delta_ = kNaN;
   std::array<ChannelState, 2> chan_;  ///< v, r
