@@ -25,7 +25,8 @@ static_assert(pipeline::kPauseNotArmed == fdi::PAUSE_NOT_ARMED &&
                   pipeline::kPauseInsUnusable == fdi::PAUSE_INS_UNUSABLE &&
                   pipeline::kPauseInsSilent == fdi::PAUSE_INS_SILENT &&
                   pipeline::kPauseFault == fdi::PAUSE_FAULT &&
-                  pipeline::kPauseObserver == fdi::PAUSE_OBSERVER,
+                  pipeline::kPauseObserver == fdi::PAUSE_OBSERVER &&
+                  pipeline::kPauseModelMismatch == fdi::PAUSE_MODEL_MISMATCH,
               "PauseReason differs from idl/usv_fdi.idl PAUSE_*");
 
 fdi::FaultEvent to_dds(const FaultEvent& e, std::uint32_t mmsi) {

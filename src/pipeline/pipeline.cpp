@@ -142,7 +142,8 @@ std::string pause_reason_names(std::uint32_t reasons) {
                              {kPauseInsUnusable, "ins_unusable"},
                              {kPauseInsSilent, "ins_silent"},
                              {kPauseFault, "fault"},
-                             {kPauseObserver, "observer"}});
+                             {kPauseObserver, "observer"},
+                             {kPauseModelMismatch, "model_mismatch"}});
 }
 
 // ---------------------------------------------------------------- FdiPipeline
@@ -618,6 +619,7 @@ PipelineStatus FdiPipeline::make_status() {
   }
   if (!in.delta_ok) iso |= kPauseRudderMissing;
   if (!st.isolation.observer_problem.empty()) iso |= kPauseObserver;
+  if (st.isolation.model_mismatch) iso |= kPauseModelMismatch;
   st.identification_paused = id;
   st.isolation_paused = iso;
   st.acks_accepted = acks_accepted_.load();

@@ -160,6 +160,9 @@ enum PauseReason : std::uint32_t {
   kPauseInsSilent = 1u << 4,      ///< no INS samples at all
   kPauseFault = 1u << 5,          ///< identification: a fault suspected, active or just cleared
   kPauseObserver = 1u << 6,       ///< isolation: observer design refused (see observer_problem)
+  /// isolation: the residuals contradict the model on both channels (model mismatch, not a
+  /// sensor fault): no sensor fault is raised from them until the model holds again
+  kPauseModelMismatch = 1u << 7,
 };
 
 /// Names of the set bits ("ins_silent", "rudder_missing", ...), comma-separated.
