@@ -141,25 +141,19 @@ DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, doub
   return l;
 }
 
-VesselNotes vessel_notes(std::uint32_t identification_paused, std::uint32_t isolation_paused) {
+VesselNotes vessel_notes(std::uint32_t isolation_paused) {
   VesselNotes n;
   n.model_mismatch = (isolation_paused & fdi::PAUSE_MODEL_MISMATCH) != 0;
-  n.suspected = (identification_paused & fdi::PAUSE_FAULT) != 0;
   return n;
 }
 
-void add_vessel_notes(const VesselNotes& notes, bool any_active, DiagStatus* d) {
-  if (d->level != DiagLevel::kOk) return;
-  if (notes.model_mismatch) {
-    d->level = DiagLevel::kWarn;
-    d->message =
-        "model mismatch, not a sensor fault: the vessel's dynamics differ from the "
-        "identified model (" +
-        d->message + ")";
-  } else if (notes.suspected && !any_active) {
-    d->level = DiagLevel::kWarn;
-    d->message = "fault suspected: identification frozen (" + d->message + ")";
-  }
+void add_vessel_notes(const VesselNotes& notes, DiagStatus* d) {
+  if (d->level != DiagLevel::kOk || !notes.model_mismatch) return;
+  d->level = DiagLevel::kWarn;
+  d->message =
+      "model mismatch, not a sensor fault: the vessel's dynamics differ from the identified "
+      "model (" +
+      d->message + ")";
 }
 
 DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,

@@ -142,19 +142,19 @@ struct DiagStatus {
 DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after);
 
 /// What the vessel's FdiStatus says beyond its latched faults.
+/// (Not a suspicion: PAUSE_FAULT is set on every freeze of identification, also on healthy
+/// data whose residual passes half its threshold, and for 10 s after a clear.)
 struct VesselNotes {
   bool model_mismatch = false;  ///< isolation_paused & PAUSE_MODEL_MISMATCH
-  bool suspected = false;       ///< identification_paused & PAUSE_FAULT (suspected or just cleared)
 };
-/// From a status's pause flags (fdi::PAUSE_*).
-VesselNotes vessel_notes(std::uint32_t identification_paused, std::uint32_t isolation_paused);
+/// From a status's isolation pause flags (fdi::PAUSE_*).
+VesselNotes vessel_notes(std::uint32_t isolation_paused);
 
 /// The statuses of one vessel: "usv_fdi: <mmsi> accelerometer" and "... gyro" always,
 /// "... unknown" once the sidecar has published that instance. hardware_id is the MMSI;
 /// values C_a, C_g, statistic (J_N), threshold, state, sequence, kind.
 /// `row_of(sensor)` gives the vessel's instance of a sensor or nullptr. A sensor that would
-/// be OK is WARN while the vessel reports a model mismatch (not a sensor fault), or a fault
-/// suspected while none of its faults is active.
+/// be OK is WARN while the vessel reports a model mismatch (not a sensor fault).
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
                                            double silent_after, const VesselNotes& notes = {});
@@ -163,24 +163,17 @@ DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row
                                double silent_after);
 
 /// A status that would be OK told what the vessel's FdiStatus adds (see vessel_diagnostics).
-void add_vessel_notes(const VesselNotes& notes, bool any_active, DiagStatus* d);
+void add_vessel_notes(const VesselNotes& notes, DiagStatus* d);
 
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
                                            double silent_after, const VesselNotes& notes) {
   std::vector<DiagStatus> out;
-  bool any_active = false;
-  for (const Sensor s : {Sensor::kAccelerometer, Sensor::kGyro, Sensor::kUnknown}) {
-    const Row* row = row_of(s);
-    any_active =
-        any_active || (row != nullptr && (row->ev.state == FaultState::kRaised ||
-                                          row->ev.state == FaultState::kActiveAcknowledged));
-  }
   for (const Sensor s : {Sensor::kAccelerometer, Sensor::kGyro, Sensor::kUnknown}) {
     const Row* row = row_of(s);
     if (s == Sensor::kUnknown && row == nullptr) continue;
     out.push_back(instance_diagnostic(mmsi, s, row, heard_age, silent_after));
-    add_vessel_notes(notes, any_active, &out.back());
+    add_vessel_notes(notes, &out.back());
   }
   return out;
 }

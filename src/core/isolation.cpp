@@ -85,7 +85,9 @@ void IsolationParams::validate() const {
   require(drift_k > 0, "drift_k", drift_k, "must be > 0");
   require(drift_threshold > 0, "drift_threshold", drift_threshold, "must be > 0");
   require(drift_lag >= 0, "drift_lag", drift_lag, "must be >= 0");
-  require(drift_min_history >= 0, "drift_min_history", drift_min_history, "must be >= 0");
+  require(drift_min_history >= 0 && (!drift_check || drift_min_history <= history),
+          "drift_min_history", drift_min_history,
+          "must lie in [0, history] (the healthy maxima cover at most history)");
   jump.validate();
 }
 

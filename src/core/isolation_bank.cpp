@@ -305,6 +305,8 @@ bool Isolator::evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_
       // no less likely to come again.
       ++st_.designs;
       publish_bank();
+      // The drift test's CUSUMs carry over (a redesign follows A by a few per cent; starting
+      // them again at every redesign let a drift that moves A^ escape them).
     }
   }
   st_.settling = s.t < act_.settle_until;

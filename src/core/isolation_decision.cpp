@@ -279,9 +279,11 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
   }
 }
 
-void Isolator::reset_drift() {
+void Isolator::reset_drift(double t) {
   drift_hi_.fill(0.0);
   drift_lo_.fill(0.0);
+  drift_from_hi_.fill(t);
+  drift_from_lo_.fill(t);
   st_.drift_S = Vec2::Zero();
 }
 
@@ -290,18 +292,24 @@ void Isolator::drift_checks(double t, double dt, const Statistics& x, bool learn
   // The CUSUMs run while nothing is raised, the model holds and the observers are live;
   // anything else starts them again from zero (a fault's evidence was used by its raise,
   // and a model mismatch is not a drift).
+  // Samples the test did not see (a gap, settling, no rudder: residual_checks returned
+  // before it) start it again too.
   bool any = false;
   for (const SensorState& x_s : sens_) any = any || x_s.cond.active;
   const bool run = p_.drift_check && model_live() && !any && !st_.model_mismatch &&
-                   t - t_last_fault_ >= p_.resume_after_fault && dt > 0 && dt <= p_.stale_timeout &&
-                   !(t < chan_[0].resettle_until) && !(t < chan_[1].resettle_until) &&
-                   x.sw.allFinite();
+                   t - t_last_fault_ >= p_.resume_after_fault && dt > 0 &&
+                   !(t - drift_last_t_ > p_.stale_timeout) && !(t < chan_[0].resettle_until) &&
+                   !(t < chan_[1].resettle_until);
   st_.drift_threshold = Vec2::Zero();
   if (!run) {
-    reset_drift();
+    reset_drift(t);
     pending_drift_.clear();
+    drift_last_t_ = t;
     return;
   }
+  // A sample with an unusable channel is skipped (held), not a reason to start again.
+  if (!x.sw.allFinite()) return;
+  drift_last_t_ = t;
   double S[2];
   for (int c = 0; c < 2; ++c) {
     const double w = std::max(-p_.clip, std::min(x.sw(c), p_.clip));
@@ -357,7 +365,7 @@ void Isolator::drift_checks(double t, double dt, const Statistics& x, bool learn
   sens_[c].raised_at = t;
   sens_[c].below_since = kNaN;
   chan_[c].refine_at = t + 0.5 * p_.classify_window;
-  reset_drift();
+  reset_drift(t);
 }
 
 FaultKind Isolator::classify(int ch) const {

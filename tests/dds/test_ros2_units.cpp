@@ -193,12 +193,11 @@ TEST(Ros2Diagnostics, OneStatusPerSensorNamedByVesselWithTheEventsValues) {
   EXPECT_EQ(st[1].values, want);
 }
 
-TEST(Ros2Diagnostics, AModelMismatchOrASuspicionIsAWarningNotAnError) {
+TEST(Ros2Diagnostics, AModelMismatchIsAWarningNotAnError) {
   // GIVEN a vessel whose status reports a model mismatch (FdiStatus.isolation_paused)
   const auto none = [](Sensor) -> const Row* { return nullptr; };
-  const VesselNotes mismatch = vessel_notes(0, fdi::PAUSE_MODEL_MISMATCH | fdi::PAUSE_LEARNING);
+  const VesselNotes mismatch = vessel_notes(fdi::PAUSE_MODEL_MISMATCH | fdi::PAUSE_LEARNING);
   EXPECT_TRUE(mismatch.model_mismatch);
-  EXPECT_FALSE(mismatch.suspected);
   // THEN both sensors are WARN with the reason, and none is an error
   for (const DiagStatus& d : vessel_diagnostics(257000001, none, 0.1, 5.0, mismatch)) {
     EXPECT_EQ(d.level, DiagLevel::kWarn) << d.name;
@@ -211,19 +210,10 @@ TEST(Ros2Diagnostics, AModelMismatchOrASuspicionIsAWarningNotAnError) {
   EXPECT_EQ(raised[0].level, DiagLevel::kWarn);
   EXPECT_EQ(raised[1].level, DiagLevel::kError);
   EXPECT_EQ(vessel_diagnostics(257000001, none, 9.0, 5.0, mismatch)[0].level, DiagLevel::kStale);
-  // AND a suspicion (identification frozen) warns while no fault of the vessel is active,
-  const VesselNotes suspected = vessel_notes(fdi::PAUSE_FAULT, 0);
-  for (const DiagStatus& d : vessel_diagnostics(257000001, none, 0.1, 5.0, suspected)) {
-    EXPECT_EQ(d.level, DiagLevel::kWarn) << d.name;
-    EXPECT_NE(d.message.find("fault suspected"), std::string::npos) << d.message;
-  }
-  //   but not on the healthy sensor beside a raised one (the freeze is that fault's)
-  const auto beside = vessel_diagnostics(
-      257000001, [&](Sensor s) { return s == Sensor::kGyro ? &g : nullptr; }, 0.1, 5.0, suspected);
-  EXPECT_EQ(beside[0].level, DiagLevel::kOk);
-  // AND nothing reported: OK
-  EXPECT_EQ(vessel_diagnostics(257000001, none, 0.1, 5.0, vessel_notes(0, 0))[0].level,
-            DiagLevel::kOk);
+  // AND other pause reasons (a frozen identification, learning) are no warning
+  const VesselNotes other = vessel_notes(fdi::PAUSE_FAULT | fdi::PAUSE_LEARNING);
+  EXPECT_FALSE(other.model_mismatch);
+  EXPECT_EQ(vessel_diagnostics(257000001, none, 0.1, 5.0, other)[0].level, DiagLevel::kOk);
 }
 
 }  // namespace

@@ -206,9 +206,11 @@ isolation:
   stuck_time_max: 4
   spike_count: 5
   classify_window: 9
-  drift_check: false
+  drift_check: true
   drift_k: 0.25
+  drift_threshold: 7
   drift_lag: 30
+  drift_min_history: 90
   history_margin: 2.5
   history: 1200
   second_fault_time: 3.5
@@ -236,9 +238,11 @@ service:
   EXPECT_EQ(c.isolation.poles_g, Vec2(-3, -4));
   EXPECT_EQ(c.isolation.stuck_min_samples, 7);
   EXPECT_EQ(c.isolation.classify_window, 9.0);
-  EXPECT_FALSE(c.isolation.drift_check);
+  EXPECT_TRUE(c.isolation.drift_check);
   EXPECT_EQ(c.isolation.drift_k, 0.25);
+  EXPECT_EQ(c.isolation.drift_threshold, 7.0);
   EXPECT_EQ(c.isolation.drift_lag, 30.0);
+  EXPECT_EQ(c.isolation.drift_min_history, 90.0);
   EXPECT_EQ(c.isolation.history_margin, 2.5);
   EXPECT_EQ(c.isolation.history, 1200.0);
   EXPECT_FALSE(c.identification.cubic_correction);

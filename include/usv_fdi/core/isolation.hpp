@@ -368,7 +368,7 @@ class Isolator {
   /// The drift test of both channels on one sample (IsolationParams::drift_k).
   void drift_checks(double t, double dt, const Statistics& x, bool learn_ok, const Levels& lv,
                     std::vector<Detection>* out);
-  void reset_drift();
+  void reset_drift(double t);
   /// The fault kind of a channel from its histories (core/fault_kind.hpp).
   FaultKind classify(int ch) const;
   std::size_t window_samples(double dt) const;
@@ -412,6 +412,7 @@ class Isolator {
   // 0), and their healthy maxima, learned from values drift_lag old.
   std::array<double, 2> drift_hi_{}, drift_lo_{};
   std::array<double, 2> drift_from_hi_{}, drift_from_lo_{};
+  double drift_last_t_ = kNaN;  ///< the last sample the test saw
   HealthyMaxima<2> drift_healthy_;
   struct PendingDrift {
     double t;
