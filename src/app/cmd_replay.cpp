@@ -232,6 +232,11 @@ void register_replay_command(CommandRegistry& registry) {
                   "data time between estimate records [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  sub->add_option("--signals", args->options.signal_period,
+                  "also write a signal record (J_N per channel, its thresholds, C_a, C_g) every "
+                  "S seconds of data time, for usv-fdi plot (default 0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   sub->add_flag("--auto-ack", args->options.auto_ack,
                 "acknowledge every event at once (latches return to normal when clear)");
 }

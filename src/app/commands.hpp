@@ -8,6 +8,7 @@ namespace usvfdi::app {
 void register_replay_command(CommandRegistry& registry);   // cmd_replay.cpp
 void register_sim_command(CommandRegistry& registry);      // cmd_sim.cpp
 void register_vessels_command(CommandRegistry& registry);  // cmd_vessels.cpp
+void register_plot_command(CommandRegistry& registry);     // cmd_plot.cpp (matplotlib)
 #ifdef USV_FDI_APP_WITH_DDS
 void register_run_command(CommandRegistry& registry);      // cmd_run.cpp (DDS service)
 void register_monitor_command(CommandRegistry& registry);  // cmd_monitor.cpp (DDS subscriber)

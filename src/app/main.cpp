@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   register_replay_command(registry);
   register_sim_command(registry);
   register_vessels_command(registry);
+  register_plot_command(registry);
 #ifdef USV_FDI_APP_WITH_DDS  // defined by src/app/CMakeLists.txt once the DDS commands exist
   register_run_command(registry);
   register_monitor_command(registry);

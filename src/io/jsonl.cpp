@@ -143,6 +143,16 @@ void JsonlWriter::mismatch(double t, bool active, const std::string& reason) {
        << ",\"reason\":" << json_string(active ? reason : "model holds again") << "}\n";
 }
 
+void JsonlWriter::signal(double t, const IsolatorStatus& iso) {
+  const auto pair = [](const Vec2& x) {
+    return "[" + json_number(x(0), 6) + "," + json_number(x(1), 6) + "]";
+  };
+  out_ << "{\"type\":\"signal\",\"t\":" << json_number(t) << ",\"armed\":" << boolean(iso.armed)
+       << ",\"mismatch\":" << boolean(iso.model_mismatch) << ",\"j\":" << pair(iso.J)
+       << ",\"threshold\":" << pair(iso.thresholds) << ",\"c_a\":" << json_number(iso.c_a, 6)
+       << ",\"c_g\":" << json_number(iso.c_g, 6) << "}\n";
+}
+
 void JsonlWriter::estimate(double t, const Estimate& est, bool armed) {
   out_ << "{\"type\":\"estimate\",\"t\":" << json_number(t) << ",\"a\":" << array4(to_params(est.A))
        << ",\"converged\":" << boolean(est.converged)

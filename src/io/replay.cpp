@@ -33,6 +33,7 @@ class Replay {
     if (std::isnan(last_t_) || s.t > last_t_) last_t_ = s.t;
     record_mismatch(s.t);
     record_estimate(s.t);
+    record_signal(s.t);
   }
 
   /// The final estimate record and the summary's totals (the caller writes the summary).
@@ -111,13 +112,22 @@ class Replay {
     }
   }
 
+  /// A signal record every signal_period (none when it is 0).
+  void record_signal(double t) {
+    if (options_.signal_period <= 0.0) return;
+    if (std::isnan(last_signal_) || t >= last_signal_ + options_.signal_period) {
+      out_.signal(t, engine_.isolation_status());
+      last_signal_ = t;
+    }
+  }
+
   const EngineConfig& cfg_;
   JsonlWriter& out_;
   const ReplayOptions& options_;
   FdiEngine engine_;
   RunSummary sum_;
   std::vector<FaultEvent> events_;
-  double first_t_ = kNaN, last_t_ = kNaN, last_record_ = kNaN;
+  double first_t_ = kNaN, last_t_ = kNaN, last_record_ = kNaN, last_signal_ = kNaN;
   bool last_converged_ = false, last_armed_ = false, last_mismatch_ = false;
   PlausibilityCheck plausible_;
   FaultState latched_[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};

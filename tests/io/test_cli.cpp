@@ -379,6 +379,131 @@ TEST_F(Cli, VesselsListsTheShippedModels) {
   EXPECT_TRUE(has(r.out, "Fossen")) << r.out;
 }
 
+// usv-fdi plot draws what the records say: every curve and every fault event of the paper's
+// scenario (noise-free, as the golden replay), found by its id in the SVG.
+TEST_F(Cli, PlotDrawsThePapersFiguresWithEveryEventAndInjectedFault) {
+  const std::string csv = path("paper.csv"), jsonl = path("paper.jsonl");
+  ASSERT_EQ(run("sim --vessel otter --scenario paper --rate 10 --noise-scale 0 --seed 1 "
+                "--output '" +
+                csv + "'")
+                .code,
+            0);
+  const Outcome replay = run("replay --config '" + kSource + "/config/scenarios/paper.yaml' " +
+                             "--input '" + csv + "' --output '" + jsonl + "' --signals 0.5");
+  ASSERT_EQ(replay.code, 0) << replay.err;
+
+  // Signal records every 0.5 s of data time (0 to 100 s at 10 Hz: t = 0, then every 5th row).
+  std::vector<double> signal_t;
+  std::vector<std::pair<std::string, std::string>> events;  // (state, sensor)
+  for (const js::Value& rec : parse_lines(slurp(jsonl))) {
+    const std::string type = rec.at("type").str;
+    if (type == "event") events.emplace_back(rec.at("state").str, rec.at("sensor").str);
+    if (type != "signal") continue;
+    signal_t.push_back(rec.at("t").num);
+    EXPECT_EQ(rec.at("j").arr.size(), 2u);
+    EXPECT_EQ(rec.at("threshold").arr.size(), 2u);
+    EXPECT_TRUE(rec.has("c_a") && rec.has("c_g") && rec.has("armed") && rec.has("mismatch"));
+  }
+  ASSERT_EQ(signal_t.size(), 201u);
+  for (std::size_t i = 1; i < signal_t.size(); ++i) {
+    EXPECT_NEAR(signal_t[i] - signal_t[i - 1], 0.5, 1e-6) << i;
+  }
+  ASSERT_EQ(events.size(), 4u);  // both faults raised and cleared
+
+  const std::string out = path("figs");
+  const Outcome r = run("plot --input '" + jsonl + "' --csv '" + csv + "' --format svg " +
+                        "--truth -0.883024,-0.438614,-1.55172,-1.16124 --output '" + out + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, out + "/fig1-estimate.svg\n" + out + "/fig2-signals.svg\n");
+  const std::string fig1 = slurp(out + "/fig1-estimate.svg");
+  for (const char* id : {"error-a1", "error-a2", "error-a3", "error-a4", "time-converged"}) {
+    EXPECT_TRUE(has(fig1, std::string("id=\"") + id + "\"")) << id;
+  }
+  EXPECT_TRUE(has(fig1, "estimation error of A"));
+  const std::string fig2 = slurp(out + "/fig2-signals.svg");
+  for (const char* id :
+       {"j-accelerometer", "j-gyro", "threshold-accelerometer", "threshold-gyro", "c-accelerometer",
+        "c-gyro", "time-armed", "fault-gyro-0", "fault-accelerometer-1"}) {
+    EXPECT_TRUE(has(fig2, std::string("id=\"") + id + "\"")) << id;
+  }
+  EXPECT_FALSE(has(fig2, "id=\"fault-gyro-1\"")) << "one gyro fault was injected";
+  for (const auto& [state, sensor] : events) {
+    const std::string id = "id=\"event-" + state + "-" + sensor + "-";
+    EXPECT_TRUE(has(fig2, id)) << id;
+  }
+
+  // PNG, the default; Â over time without --truth; no Fig. 2 without signal records.
+  const std::string plain = path("plain.jsonl");
+  ASSERT_EQ(run("replay --config '" + kSource + "/config/scenarios/paper.yaml' --input '" + csv +
+                "' --output '" + plain + "'")
+                .code,
+            0);
+  const Outcome p = run("plot --input '" + plain + "' --output '" + path("png") + "'");
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_EQ(p.out, path("png") + "/fig1-estimate.png\n");
+  EXPECT_TRUE(has(p.err, "no signal record: no Fig. 2 (replay with --signals S")) << p.err;
+  EXPECT_EQ(slurp(path("png") + "/fig1-estimate.png").substr(0, 8), "\x89PNG\r\n\x1a\n");
+}
+
+TEST_F(Cli, PlotNamesWhatIsWrongWithItsInput) {
+  const auto plot = [this](const std::string& args, const std::string& env = "") {
+    return run("plot " + args, "cd '" + dir_ + "' && " + env);
+  };
+  const std::string good =
+      R"({"type":"estimate","t":0,"a":[1,2,3,4],"converged":false,"armed":false})";
+  spit(path("bad.jsonl"), good + "\noops\n");
+  Outcome r = plot("--input bad.jsonl");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "bad.jsonl:2: not a JSON record")) << r.err;
+
+  spit(path("short.jsonl"), good + "\n" + R"({"type":"estimate","t":1,"a":[1,2]})" + "\n");
+  r = plot("--input short.jsonl");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "short.jsonl:2: estimate record: 'a' must be an array of 4 numbers"))
+      << r.err;
+
+  spit(path("signal.jsonl"), R"({"type":"signal","t":1,"j":[1,2],"c_a":0,"c_g":1})"
+                             "\n");
+  r = plot("--input signal.jsonl");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err,
+                  "signal.jsonl:1: signal record: 'threshold' must be an array of 2 "
+                  "numbers [accelerometer, gyro], got missing"))
+      << r.err;
+
+  spit(path("summary.jsonl"), R"({"type":"summary","samples":0})"
+                              "\n");
+  r = plot("--input summary.jsonl");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "summary.jsonl: no estimate or signal record")) << r.err;
+
+  r = plot("--input missing.jsonl");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "missing.jsonl: cannot be read: No such file or directory")) << r.err;
+
+  spit(path("ok.jsonl"), good + "\n");
+  spit(path("nofaults.csv"), "t,v,r,delta\n0,0,0,0\n");
+  r = plot("--input ok.jsonl --csv nofaults.csv");
+  EXPECT_EQ(r.code, 3);
+  EXPECT_TRUE(has(r.err, "nofaults.csv:1: no fault_a or fault_g column")) << r.err;
+
+  r = plot("--input ok.jsonl --truth 1,2,x,4");
+  EXPECT_EQ(r.code, 64);
+  EXPECT_TRUE(has(r.err, "not a finite number: 'x'")) << r.err;
+  EXPECT_EQ(plot("--input ok.jsonl --truth 1,2,3").code, 64);
+  EXPECT_EQ(plot("--input ok.jsonl --format jpg").code, 64);
+
+  spit(path("file"), "");
+  r = plot("--input ok.jsonl --output file/figs");
+  EXPECT_EQ(r.code, 4);
+  EXPECT_TRUE(has(r.err, "file/figs: cannot create the directory")) << r.err;
+
+  r = plot("--input ok.jsonl", "USV_FDI_PYTHON=/nonexistent/python3 ");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(has(r.err, "needs python3 and python3-matplotlib")) << r.err;
+  EXPECT_TRUE(has(r.err, "cannot start /nonexistent/python3")) << r.err;
+}
+
 TEST_F(Cli, UsageErrors) {
   EXPECT_EQ(run("").code, 64);
   EXPECT_EQ(run("frobnicate").code, 64);

@@ -2,6 +2,8 @@
 //
 //   {"type":"event",<the fault event's fields, fault_event_fields()>}
 //   {"type":"estimate","t":..,"a":[a1,a2,a3,a4],"converged":bool,"excitation":..,"armed":bool}
+//   {"type":"signal","t":..,"armed":bool,"mismatch":bool,"j":[a,g],"threshold":[a,g],
+//    "c_a":..,"c_g":..}   (replay --signals S only)
 //   {"type":"summary","samples":n,"rejected":n,"events":n,
 //    "raised":{"accelerometer":n,"gyro":n,"unknown":n},"final_a":[..],"converged":bool,
 //    "frozen_samples":n,"duration_s":..,"complete":bool[,"error":".."]}
@@ -73,6 +75,10 @@ class JsonlWriter {
   void event(const FaultEvent& e);
   /// t: data time of the record [s] (the estimate itself may lag by the identification delay).
   void estimate(double t, const Estimate& est, bool armed);
+  /// The fault signals at data time t: the windowed statistic J_N per channel [accelerometer,
+  /// gyro] and its enter thresholds, the isolation confidences C_a and C_g (6 significant
+  /// digits: these records are for plots).
+  void signal(double t, const IsolatorStatus& iso);
   /// A model-mismatch verdict began (active, with its reason) or ended.
   void mismatch(double t, bool active, const std::string& reason);
   void summary(const RunSummary& s);
