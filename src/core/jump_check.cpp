@@ -53,6 +53,8 @@ void JumpParams::validate() const {
   require(max_gap > 0, "max_gap", max_gap, "must be > 0");
   require(b_uncertainty >= 0, "b_uncertainty", b_uncertainty, "must be >= 0");
   require(rudder_lag >= 0, "rudder_lag", rudder_lag, "must be >= 0");
+  require(bend_margin >= 0, "bend_margin", bend_margin, "must be >= 0");
+  require(bend_rate >= 0, "bend_rate", bend_rate, "must be >= 0");
 }
 
 // ------------------------------------------------------------------------------ Series
@@ -144,6 +146,13 @@ void JumpCheck::resize_windows() {
     const double lever = 0.5 * (L_ + 1) + 0.5 * m;
     c_[static_cast<std::size_t>(m)] = 1.0 / (m + 1) + 1.0 / L_ + lever * lever / Sjj;
   }
+  // f_m of t^2 / 2 (the same for any time origin: a line absorbs the rest of a shift).
+  Series bend;
+  bend.reset(L_, M_);
+  for (int j = 0; j <= L_ + M_; ++j) bend.push(0.5 * (j * dt_) * (j * dt_));
+  bend_.assign(static_cast<std::size_t>(M_), 0.0);
+  bend.steps(M_ - 1, bend_.data());
+  for (double& g : bend_) g = std::abs(g);
   inv_c_.resize(c_.size());
   for (std::size_t m = 0; m < c_.size(); ++m) inv_c_[m] = 1.0 / c_[m];
   f_.assign(static_cast<std::size_t>(M_), 0.0);
@@ -185,7 +194,7 @@ void JumpCheck::keep_newest(int keep) {
 }
 
 void JumpCheck::step_statistics(int* m_best, double* f_best) {
-  T_ = 0.0;
+  T_ = T_learn_ = 0.0;
   *m_best = -1;
   *f_best = 0.0;
   const int m_hi = std::min(M_ - 1, z_.count() - L_ - 1);
@@ -197,17 +206,35 @@ void JumpCheck::step_statistics(int* m_best, double* f_best) {
   for (int m = persist_ - 1; m <= m_hi; ++m) raw = std::max(raw, f_[m] * f_[m] * inv_c_[m]);
   raw /= s2;
   if (raw <= kDiscountFrom * p_.threshold) {
-    T_ = raw;  // an upper bound, far below any threshold
+    T_ = T_learn_ = raw;  // an upper bound, far below any threshold
     return;
   }
   // What an error of B (b_uncertainty) and a lagging rudder sensor (rudder_lag) could make
   // of the same windows: the rudder's part of z is known only that well.
   i_.steps(m_hi, fi_.data());
   d_.steps(m_hi, fd_.data());
+  // The largest bend the rudder can drive in these windows: |z''| = |a_row . x'| with x'
+  // driven by b delta, so at most bend_rate |b| max|delta| (a hull whose rudder is near
+  // midships, holding a course in waves, bends z with the waves, which the bar learned).
+  double delta_max = 0.0;
+  for (int back = 0; back <= m_hi + L_; ++back)
+    delta_max = std::max(delta_max, std::abs(d_.at(back)));
+  const double bend_cap = p_.bend_rate * std::abs(b_) * delta_max;
   for (int m = persist_ - 1; m <= m_hi; ++m) {
-    const double doubt =
+    // z's bend before the onset: the change of its slope from the pre window before the
+    // last to the last [per s^2] (when the samples held reach back that far).
+    const double zdd = z_.count() >= 2 * L_ + m + 1
+                           ? (z_.slope_before(m) - z_.slope_before(m + L_)) / (L_ * dt_ * dt_)
+                           : 0.0;
+    const double rudder_doubt =
         std::abs(b_) * (p_.b_uncertainty * std::abs(fi_[m]) + p_.rudder_lag * std::abs(fd_[m]));
-    const double excess = std::max(0.0, std::abs(f_[m]) - doubt);
+    // The healthy maximum is learned without the bend's discount: the bar stays where the
+    // hull's bends put it, and the discount only keeps a bend under way from crossing it.
+    const double learn_excess = std::max(0.0, std::abs(f_[m]) - rudder_doubt);
+    T_learn_ = std::max(T_learn_, learn_excess * learn_excess / (s2 * c_[m]));
+    const double bend = std::min(p_.bend_margin * std::abs(zdd), bend_cap);
+    const double excess =
+        std::max(0.0, std::abs(f_[m]) - rudder_doubt - bend * bend_[static_cast<std::size_t>(m)]);
     const double Tm = excess * excess / (s2 * c_[m]);
     if (Tm > T_) {
       T_ = Tm;
@@ -333,7 +360,7 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   const double e2 = f_[0] * f_[0] / c_[0];
   const double d2 = z_.at(0) - 2.0 * z_.at(1) + z_.at(2);
   noise_statistic(d2 * d2);
-  queue_for_learning(Pending{t, T_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_});
+  queue_for_learning(Pending{t, T_learn_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_});
   armed_ = p_.enabled && learned_ >= p_.learn_time;
   // Watched from half the learning on (the scales have settled), reported once armed: a
   // fault before arming is kept out of the learning, and its end is not taken for a new one.

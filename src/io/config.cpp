@@ -368,6 +368,8 @@ class Loader {
         {"max_gap", number_into(&jp->max_gap, {0, kHour, "s"})},
         {"b_uncertainty", number_into(&jp->b_uncertainty, {0, 100, ""})},
         {"rudder_lag", number_into(&jp->rudder_lag, {0, 60, "s"})},
+        {"bend_margin", number_into(&jp->bend_margin, {0, 100, "-"})},
+        {"bend_rate", number_into(&jp->bend_rate, {0, 100, "1/s"})},
     };
   }
 

@@ -120,6 +120,8 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(j.max_gap, k.max_gap);
   EXPECT_EQ(j.b_uncertainty, k.b_uncertainty);
   EXPECT_EQ(j.rudder_lag, k.rudder_lag);
+  EXPECT_EQ(j.bend_margin, k.bend_margin);
+  EXPECT_EQ(j.bend_rate, k.bend_rate);
   EXPECT_EQ(p.spike_window, q.spike_window);
   EXPECT_EQ(p.spike_count, q.spike_count);
   EXPECT_EQ(p.invalid_count, q.invalid_count);
@@ -222,6 +224,8 @@ jump:
   margin: 3
   hold_max: 45
   rudder_lag: 0.1
+  bend_margin: 0.5
+  bend_rate: 3
 service:
   domain_id: 7
   mmsi: 257000000
@@ -265,6 +269,8 @@ service:
   EXPECT_EQ(c.isolation.jump.margin, 3.0);
   EXPECT_EQ(c.isolation.jump.hold_max, 45.0);
   EXPECT_EQ(c.isolation.jump.rudder_lag, 0.1);
+  EXPECT_EQ(c.isolation.jump.bend_margin, 0.5);
+  EXPECT_EQ(c.isolation.jump.bend_rate, 3.0);
 }
 
 TEST(ConfigError, AJumpCheckKeyOutOfItsRangeIsNamed) {

@@ -61,6 +61,16 @@ struct JumpParams {
   /// the rudder sensor may lag by rudder_lag; a step is only what these cannot explain [-]
   double b_uncertainty = 0.5;
   double rudder_lag = 0.3;  ///< [s]
+  /// The hull's own dynamics bend z (z'' = a_row . x': the Otter's yaw rate answers a rudder
+  /// step within a second), which a line fitted before the onset and extrapolated misses; at
+  /// 10 Hz a zigzag's bend looked like a step. The step test also discounts
+  /// min(bend_margin |z''|, bend_rate |b| max|delta|) |f_m(t^2 / 2)|: z'' is the change of
+  /// z's slope between the two pre windows before the onset (the bend seen may grow
+  /// bend_margin times), and the rudder bounds the bend it can drive (a hull's rate 1/T up to
+  /// bend_rate), so that waves, which bend z with the rudder near midships, are no excuse.
+  /// Either 0: no such discount [-], [1/s].
+  double bend_margin = 2.0;
+  double bend_rate = 2.0;
 
   /// Throws std::invalid_argument naming the offending field.
   void validate() const;
@@ -123,6 +133,11 @@ class JumpCheck {
     void steps(int m_hi, double* f) const;
     /// The line fitted before the last m + 1 samples, at `back` samples before the newest.
     double line(int m, int back) const;
+    /// That line's slope [per sample].
+    double slope_before(int m) const {
+      const int k = newest_ - (m + 1);
+      return slope_[static_cast<std::size_t>(k < 0 ? k + cap_ : k)];
+    }
 
    private:
     int L_ = 0, M_ = 0, cap_ = 1;
@@ -170,6 +185,7 @@ class JumpCheck {
   Series z_, i_, d_;                 ///< z = y - b int(delta), int(delta) [rad s], delta [rad]
   std::vector<double> ts_;           ///< times of the samples held (a ring like the series')
   std::vector<double> c_, inv_c_;    ///< variance factor c_m of f_m, and 1 / c_m
+  std::vector<double> bend_;         ///< |f_m| of t^2 / 2 [s^2]: a constant z'' = 1
   std::vector<double> f_, fi_, fd_;  ///< scratch: f_m of z, int(delta), delta
   int L_ = 0, M_ = 0;                ///< pre window, longest post window [samples]
   int persist_ = 1;                  ///< samples a jump must last
@@ -194,6 +210,7 @@ class JumpCheck {
   int d2_since_exact_ = 0;
   // Verdicts.
   double T_ = 0.0, N_ = 0.0;
+  double T_learn_ = 0.0;  ///< T without the bend's discount: what the healthy maximum learns
   double threshold_ = 0.0, noise_threshold_ = 0.0;
   bool raised_ = false;
   bool step_reported_ = false, noise_reported_ = false;  ///< their raise was reported
