@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "commands.hpp"
 #include "credentials.hpp"
@@ -18,6 +19,7 @@
 #include "usv_fdi/dds_service/health.hpp"
 #include "usv_fdi/dds_service/service.hpp"
 #include "usv_fdi/io/config.hpp"
+#include "usv_fdi/metrics/metrics.hpp"
 
 namespace usvfdi::app {
 namespace {
@@ -32,6 +34,7 @@ struct RunArgs {
   std::optional<std::string> state_dir;
   bool no_state = false;
   std::string health_file;
+  std::string metrics;
   const CLI::App* root = nullptr;
 };
 
@@ -178,6 +181,7 @@ int load_run_config(const RunArgs& a, dds_service::ServiceConfig* out) {
     cfg.state_dir_explicit = true;
   }
   if (!a.health_file.empty()) cfg.health_file = a.health_file;
+  if (!a.metrics.empty()) cfg.metrics = a.metrics;
   if (cfg.mmsi == 0) {
     spdlog::error("{}: service.mmsi is not set (give the vessel's MMSI there or with --mmsi)",
                   a.dds.config);
@@ -230,11 +234,28 @@ void log_started(const dds_service::ServiceConfig& cfg, const dds_service::FdiSe
       cfg.health_file.empty() ? std::string("none") : cfg.health_file);
 }
 
+/// The Prometheus endpoint (service.metrics), or nullptr when none is configured or it cannot
+/// listen (logged: the sidecar runs on without it, since its alarms matter more).
+std::unique_ptr<metrics::SidecarMetrics> start_metrics(const dds_service::ServiceConfig& cfg) {
+  if (cfg.metrics.empty()) return nullptr;
+  try {
+    auto m = std::make_unique<metrics::SidecarMetrics>(cfg.metrics, cfg.mmsi);
+    const std::vector<int> ports = m->ports();
+    const std::string host = cfg.metrics.substr(0, cfg.metrics.rfind(':'));
+    spdlog::info("metrics: http://{}:{}/metrics", host, ports.empty() ? 0 : ports.front());
+    return m;
+  } catch (const std::exception& e) {
+    spdlog::error("{} (service.metrics / --metrics; the sidecar runs without metrics)", e.what());
+    return nullptr;
+  }
+}
+
 /// Runs until SIGINT or SIGTERM (*sig), writing the health file every status period and
 /// logging every change of the matched endpoints. Returns kExitOk, or kExitFailure (the
 /// service stopped) when the credentials expire.
 int watch_until_signal(dds_service::FdiService* svc, HealthWriter* health,
-                       const CredentialExpiry& expiry, double period, int* sig) {
+                       metrics::SidecarMetrics* metrics, const CredentialExpiry& expiry,
+                       double period, int* sig) {
   dds_service::FdiService::Matches seen;
   auto last_health = std::chrono::steady_clock::now();
   while ((*sig = wait_for_stop_signal(std::min(0.5, period))) == 0) {
@@ -249,6 +270,7 @@ int watch_until_signal(dds_service::FdiService* svc, HealthWriter* health,
       last_health = now;
       health->write("running", "", svc);
     }
+    if (metrics != nullptr) metrics->update(svc->status(), svc->liveness());
     const dds_service::FdiService::Matches m = svc->matches();
     if (m != seen) {
       spdlog::info(
@@ -294,8 +316,9 @@ int run_service(const RunArgs& a, const AsyncLogging& logging) {
   svc->start();
   health.write("running", "", svc.get());
   log_started(cfg, *svc);
+  const std::unique_ptr<metrics::SidecarMetrics> metrics = start_metrics(cfg);
   int sig = 0;
-  rc = watch_until_signal(svc.get(), &health, expiry, period, &sig);
+  rc = watch_until_signal(svc.get(), &health, metrics.get(), expiry, period, &sig);
   if (rc != kExitOk) return rc;
   stop_service(sig, svc.get(), &health, logging);
   return kExitOk;
@@ -340,6 +363,9 @@ void register_run_command(CommandRegistry& registry) {
   sub->add_option("--health-file", args.health_file,
                   "rewrite this JSON file every status period for `usv-fdi health` (overrides "
                   "service.health_file)");
+  sub->add_option("--metrics", args.metrics,
+                  "serve Prometheus metrics on HOST:PORT, GET /metrics (overrides "
+                  "service.metrics; port 0: any free port, logged)");
 }
 
 }  // namespace usvfdi::app

@@ -159,7 +159,7 @@ void add_pipeline_keys(ServiceLoad* s, ConfigValue::Table* table) {
   t["restore_recheck"] = positive_time(&p.restore_recheck);
 }
 
-/// The process's keys: log_level, state_dir, health_file.
+/// The process's keys: log_level, state_dir, health_file, metrics.
 void add_process_keys(ServiceLoad* s, ConfigValue::Table* table) {
   ConfigValue::Table& t = *table;
   t["log_level"] = [s](const ConfigValue& v) { read_log_level(v, &s->cfg.log_level); };
@@ -167,6 +167,9 @@ void add_process_keys(ServiceLoad* s, ConfigValue::Table* table) {
   t["health_file"] = [s](const ConfigValue& v) {
     const std::string f = v.is_null() ? std::string() : v.text("a file path");
     s->cfg.health_file = f.empty() ? f : s->relative_to_config(f);
+  };
+  t["metrics"] = [s](const ConfigValue& v) {
+    s->cfg.metrics = v.is_null() ? std::string() : v.text("host:port");
   };
 }
 

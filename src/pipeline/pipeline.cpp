@@ -716,6 +716,7 @@ PipelineStatus FdiPipeline::status() const {
   st.acks_accepted = acks_accepted_.load();
   st.acks_refused = acks_refused_.load();
   st.acks_dropped = acks_.dropped();
+  for (std::size_t i = 0; i < st.raises.size(); ++i) st.raises[i] = raises_[i].load();
   return st;
 }
 
@@ -851,6 +852,12 @@ void FdiPipeline::publish(const FaultEvent& ev) {
   std::uint64_t& published = published_seq_[index_of(ev.sensor)];
   if (ev.sequence <= published) return;  // already handed over (after an overflow)
   published = ev.sequence;
+  FaultState& before = published_state_[index_of(ev.sensor)];
+  if (ev.state == FaultState::kRaised && before != FaultState::kRaised &&
+      ev.incarnation == incarnation_) {
+    raises_[index_of(ev.sensor)].fetch_add(1, std::memory_order_relaxed);
+  }
+  before = ev.state;
   try {
     if (on_event_) on_event_(ev);
   } catch (const std::exception& e) {

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -24,6 +25,7 @@
 
 #include "fleet.hpp"
 #include "starvation.hpp"
+#include "support/http_get.hpp"
 #include "test_env.hpp"
 
 namespace usvfdi::dds::test {
@@ -201,6 +203,66 @@ void run_partial_voyage(Fleet& f, unsigned m, const std::vector<std::string>& ex
   ASSERT_TRUE(code.has_value()) << "sim did not finish";
   ASSERT_EQ(*code, 0) << f.log("sim");
   ASSERT_TRUE(f.wait_for_log("svc", "accelerometer #1 raised", seconds(5))) << f.log("svc");
+}
+
+// ------------------------------------------------------------------ metrics
+
+TEST(ServiceEndToEnd, MetricsEndpointServesTheRaisesAndSignalsOfThePaperScenario) {
+  // GIVEN a sidecar with a Prometheus endpoint on a free loopback port
+  Fleet f;
+  const unsigned m = 257100013;
+  // WHEN the simulator has published the first 70 s of the paper's scenario (the gyro fault
+  // raised and cleared, the accelerometer fault raised)
+  run_partial_voyage(f, m, {"metrics: 127.0.0.1:0"});
+  const std::string log = f.log("svc");
+  const std::size_t at = log.find("metrics: http://127.0.0.1:");
+  ASSERT_NE(at, std::string::npos) << log;
+  const int port = std::atoi(log.c_str() + at + std::string("metrics: http://127.0.0.1:").size());
+  ASSERT_GT(port, 0) << log;
+  // THEN a scrape (metrics are refreshed twice a second) counts one raise of each sensor
+  const std::string mmsi = std::to_string(m);
+  std::string page;
+  const auto value = [&](const char* name, const char* key = nullptr, const char* v = nullptr) {
+    std::map<std::string, std::string> labels = {{"mmsi", mmsi}};
+    if (key != nullptr) labels[key] = v;
+    return testing_http::sample(page, name, labels);
+  };
+  const auto deadline = Clock::now() + seconds(15);
+  do {
+    page = testing_http::get(port, "/metrics");
+    if (value("usv_fdi_raises_total", "sensor", "accelerometer") == 1.0) break;
+    std::this_thread::sleep_for(milliseconds(200));
+  } while (Clock::now() < deadline);
+  ASSERT_FALSE(page.empty()) << "no answer on port " << port << "\n" << f.log("svc");
+  EXPECT_EQ(value("usv_fdi_raises_total", "sensor", "accelerometer"), 1.0) << page;
+  EXPECT_EQ(value("usv_fdi_raises_total", "sensor", "gyro"), 1.0) << page;
+  EXPECT_EQ(value("usv_fdi_raises_total", "sensor", "unknown"), 0.0) << page;
+  // AND the detector's state: converged, armed, every sample of 70 s at 50 Hz, the raised
+  // accelerometer channel's J_N above its threshold and C_a above C_g
+  EXPECT_EQ(value("usv_fdi_converged"), 1.0) << page;
+  EXPECT_EQ(value("usv_fdi_armed"), 1.0) << page;
+  EXPECT_GE(value("usv_fdi_samples_total"), 3400.0) << page;
+  const double j = value("usv_fdi_statistic", "channel", "accelerometer");
+  const double thr = value("usv_fdi_threshold", "channel", "accelerometer");
+  EXPECT_GT(thr, 0.0) << page;
+  EXPECT_GT(j, thr) << page;
+  EXPECT_GT(value("usv_fdi_isolation_confidence", "sensor", "accelerometer"),
+            value("usv_fdi_isolation_confidence", "sensor", "gyro"))
+      << page;
+  // AND the input and thread ages are there (the INS fell silent when the voyage ended), each
+  // family declared once
+  EXPECT_GE(value("usv_fdi_input_age_seconds", "input", "ins"), 0.0) << page;
+  for (const char* t : {"isolation", "identification", "publisher"}) {
+    EXPECT_GE(value("usv_fdi_thread_age_seconds", "thread", t), 0.0) << t << "\n" << page;
+  }
+  for (const char* family :
+       {"usv_fdi_statistic", "usv_fdi_raises_total", "usv_fdi_input_age_seconds"}) {
+    const std::string help = std::string("# HELP ") + family + " ";
+    const std::size_t first = page.find(help);
+    EXPECT_NE(first, std::string::npos) << family;
+    EXPECT_EQ(page.find(help, first + 1), std::string::npos) << family << " declared twice";
+  }
+  EXPECT_EQ(testing_http::get(port, "/nothing-here"), "");
 }
 
 TEST(ServiceEndToEnd, LateJoiningMonitorReceivesTheLatchedStateOfEveryInstance) {

@@ -42,6 +42,7 @@ TEST(ServiceConfig, ShippedExampleLoadsWithItsDocumentedValues) {
   EXPECT_EQ(c.state_dir, "/var/lib/usv-fdi");
   EXPECT_FALSE(c.state_dir_explicit);
   EXPECT_EQ(c.health_file, "");
+  EXPECT_EQ(c.metrics, "");  // no Prometheus endpoint unless asked
   EXPECT_DOUBLE_EQ(c.pipeline.restore_recheck, 5.0);
 }
 
@@ -65,6 +66,7 @@ service:
   restore_recheck: 8
   state_dir: state
   health_file: /run/usv-fdi/health.json
+  metrics: 0.0.0.0:9464
 )");
   const ServiceConfig c = load_service_config(path);
   EXPECT_EQ(c.mmsi, 123456789u);
@@ -90,6 +92,7 @@ service:
   EXPECT_EQ(c.state_dir, (std::filesystem::path(path).parent_path() / "state").string());
   EXPECT_TRUE(c.state_dir_explicit);
   EXPECT_EQ(c.health_file, "/run/usv-fdi/health.json");
+  EXPECT_EQ(c.metrics, "0.0.0.0:9464");
   std::remove(path.c_str());
   // An empty state_dir switches persistence off.
   const std::string off =

@@ -43,6 +43,9 @@ struct ServiceConfig {
   /// true: set by service.state_dir or --state-dir (created if missing; "" disables).
   bool state_dir_explicit = false;
   std::string health_file;  ///< service.health_file / --health-file ("" : none)
+  /// service.metrics / --metrics: "host:port" of the Prometheus endpoint ("" : none; port 0:
+  /// any free port, logged).
+  std::string metrics;
   InputSource input = InputSource::kDds;
   /// service.nmea (input: nmea): the socket and the sample assembler; the rudder sign is
   /// model.B's (nmea::rudder_sign_from_b2).
@@ -55,6 +58,7 @@ struct ServiceConfig {
 ///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level,
 ///   authorised_operators: [..], input_queue, rudder_wait, rudder_timeout, input_timeout,
 ///   restore_recheck, state_dir (relative to the config file; "" : no persistence), health_file,
+///   metrics,
 ///   input (dds | nmea), nmea: {address, port, interface, rate, max_age, receive_buffer}.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
 /// Throws usvfdi::io::ConfigError naming file, key, line and value.

@@ -199,6 +199,9 @@ struct PipelineStatus {
   std::uint64_t acks_refused = 0;  ///< unauthorised, unknown sensor, stale or unknown sequence...
   std::uint64_t acks_dropped = 0;  ///< ack queue overflow (a flood), oldest dropped
   std::uint64_t incarnation = 0;   ///< this run (PipelineOptions::incarnation)
+  /// Faults raised by this run per Sensor (published transitions into raised; a refined kind
+  /// and a restored event are none).
+  std::array<std::uint64_t, 3> raises{0, 0, 0};
 };
 
 /// Wall-clock seconds since each thread last went round its loop (an idle thread still goes
@@ -397,6 +400,9 @@ class FdiPipeline {
   std::mutex latest_m_;
   std::array<FaultEvent, 3> latest_{};
   std::array<std::uint64_t, 3> published_seq_{0, 0, 0};
+  std::array<FaultState, 3> published_state_{FaultState::kNormal, FaultState::kNormal,
+                                             FaultState::kNormal};  ///< publisher thread
+  std::array<std::atomic<std::uint64_t>, 3> raises_{};              ///< PipelineStatus::raises
 
   std::atomic<std::uint64_t> samples_{0}, rejected_{0};
   std::atomic<std::uint64_t> inputs_handled_{0}, events_emitted_{0};
