@@ -365,7 +365,14 @@ void register_run_command(CommandRegistry& registry) {
                   "service.health_file)");
   sub->add_option("--metrics", args.metrics,
                   "serve Prometheus metrics on HOST:PORT, GET /metrics (overrides "
-                  "service.metrics; port 0: any free port, logged)");
+                  "service.metrics; port 0: any free port, logged)")
+      ->check(CLI::Validator(
+          [](const std::string& s) {
+            return dds_service::is_host_port(s)
+                       ? std::string()
+                       : "must be HOST:PORT (port 0-65535), got '" + s + "'";
+          },
+          "HOST:PORT"));
 }
 
 }  // namespace usvfdi::app

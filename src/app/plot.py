@@ -10,12 +10,17 @@
 # The usv-fdi executable carries this file and runs it with python3 (src/app/cmd_plot.cpp);
 # it also runs on its own: python3 src/app/plot.py --help. Exit codes as usv-fdi's: 1 no
 # matplotlib, 3 input, 4 output, 64 command line.
-import argparse
-import csv
-import json
-import math
-import os
 import sys
+
+# Run as `python3 -c`, the working directory would come first on the path: a json.py or
+# matplotlib.py there must not be imported in place of the real ones.
+sys.path = [p for p in sys.path if p not in ("", ".")]
+
+import argparse  # noqa: E402
+import csv  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import os  # noqa: E402
 
 EXIT_FAILURE, EXIT_INPUT, EXIT_OUTPUT, EXIT_USAGE = 1, 3, 4, 64
 SENSORS = ("accelerometer", "gyro")
@@ -39,7 +44,16 @@ def number(value):
 
 
 def is_number(value):
-    return value is None or (isinstance(value, (int, float)) and not isinstance(value, bool))
+    """null, or a number a float holds (a 400-digit integer is not one)."""
+    if value is None:
+        return True
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        float(value)
+    except OverflowError:
+        return False
+    return True
 
 
 class Records:
@@ -62,6 +76,8 @@ class Records:
                 fail(EXIT_INPUT, f"{path}: not UTF-8 text: {e.reason}")
             except json.JSONDecodeError as e:
                 fail(EXIT_INPUT, f"{path}:{lineno}: not a JSON record: {e.msg} (column {e.colno})")
+            except (RecursionError, OverflowError, ValueError) as e:
+                fail(EXIT_INPUT, f"{path}:{lineno}: not a usable JSON record: {e}")
         if not self.estimates and not self.signals:
             fail(EXIT_INPUT, f"{path}: no estimate or signal record (is it the output of "
                  "usv-fdi replay?)")
@@ -93,7 +109,7 @@ class Records:
             self.signals.append(record)
         elif kind == "event":
             self.need(record, lineno, "stamp", is_number, "a number")
-            self.need(record, lineno, "sensor", lambda x: x in COLOURS,
+            self.need(record, lineno, "sensor", lambda x: isinstance(x, str) and x in COLOURS,
                       "accelerometer, gyro or unknown")
             self.need(record, lineno, "state", lambda x: isinstance(x, str), "a string")
             self.events.append(record)
@@ -113,35 +129,55 @@ def fault_intervals(path):
         f = open(path, newline="", encoding="utf-8")
     except OSError as e:
         fail(EXIT_INPUT, f"{path}: cannot be read: {e.strerror}")
-    intervals = []
     with f:
-        rows = csv.reader(line for line in f if line.strip() and not line.startswith("#"))
-        header = next(rows, None)
-        if header is None or "t" not in header:
-            fail(EXIT_INPUT, f"{path}:1: column 't': required column missing from the header")
-        it = header.index("t")
-        columns = [(s, header.index(c)) for s, c in zip(SENSORS, ("fault_a", "fault_g"))
-                   if c in header]
-        if not columns:
-            fail(EXIT_INPUT, f"{path}:1: no fault_a or fault_g column (a voyage of usv-fdi sim "
-                 "has them)")
-        start = {s: None for s, _ in columns}
-        t = float("nan")
-        for lineno, row in enumerate(rows, 2):
-            try:
-                t = float(row[it])
-            except (ValueError, IndexError):
-                fail(EXIT_INPUT, f"{path}:{lineno}: column 't': not a number")
-            for sensor, i in columns:
-                active = i < len(row) and row[i].strip() not in ("", "nan", "NaN")
-                if active and start[sensor] is None:
-                    start[sensor] = t
-                elif not active and start[sensor] is not None:
-                    intervals.append((sensor, start[sensor], t))
-                    start[sensor] = None
-        for sensor, t0 in start.items():
-            if t0 is not None:
-                intervals.append((sensor, t0, t))
+        try:
+            return csv_intervals(path, f)
+        except UnicodeDecodeError as e:
+            fail(EXIT_INPUT, f"{path}: not UTF-8 text: {e.reason}")
+        except csv.Error as e:
+            fail(EXIT_INPUT, f"{path}: not a CSV file: {e}")
+
+
+def csv_intervals(path, f):
+    """fault_intervals() of an open file (blank and # lines skipped, as replay does; the
+    messages name the file's own line numbers)."""
+    lineno = [0]
+
+    def data_lines():
+        for n, line in enumerate(f, 1):
+            if line.strip() and not line.startswith("#"):
+                lineno[0] = n
+                yield line
+
+    rows = csv.reader(data_lines())
+    header = next(rows, None)
+    if header is None or "t" not in header:
+        fail(EXIT_INPUT, f"{path}:{lineno[0]}: column 't': required column missing from the "
+             "header")
+    it = header.index("t")
+    columns = [(s, header.index(c)) for s, c in zip(SENSORS, ("fault_a", "fault_g"))
+               if c in header]
+    if not columns:
+        fail(EXIT_INPUT, f"{path}:{lineno[0]}: no fault_a or fault_g column (a voyage of "
+             "usv-fdi sim has them)")
+    intervals = []
+    start = {s: None for s, _ in columns}
+    t = float("nan")
+    for row in rows:
+        try:
+            t = float(row[it])
+        except (ValueError, IndexError):
+            fail(EXIT_INPUT, f"{path}:{lineno[0]}: column 't': not a number")
+        for sensor, i in columns:
+            active = i < len(row) and row[i].strip() not in ("", "nan", "NaN")
+            if active and start[sensor] is None:
+                start[sensor] = t
+            elif not active and start[sensor] is not None:
+                intervals.append((sensor, start[sensor], t))
+                start[sensor] = None
+    for sensor, t0 in start.items():
+        if t0 is not None:
+            intervals.append((sensor, t0, t))
     return intervals
 
 
@@ -151,8 +187,9 @@ def first_time(records, field):
 
 def mark_times(ax, est, signals):
     converged = first_time(est, "converged")
-    armed = first_time(est, "armed") if first_time(est, "armed") is not None else \
-        first_time(signals, "armed")
+    armed = first_time(est, "armed")
+    if armed is None:
+        armed = first_time(signals, "armed")
     for t, label, style in ((converged, "converged", "--"), (armed, "armed", ":")):
         if t is not None:
             ax.axvline(t, color="black", linestyle=style, linewidth=0.8, label=label,
@@ -313,17 +350,19 @@ def main():
     p.add_argument("--title")
     a = p.parse_args()
     truth = parse_truth(a.truth) if a.truth is not None else None
+    rec = Records(a.input)  # the input's mistakes are named even without matplotlib
+    faults = fault_intervals(a.csv) if a.csv else []
     try:
         import matplotlib
         matplotlib.use("Agg")
         matplotlib.rcParams["svg.fonttype"] = "none"  # text stays text in an SVG
         matplotlib.rcParams["svg.hashsalt"] = "usv-fdi"  # the same records, the same SVG
+        matplotlib.rcParams["text.parse_math"] = False  # a '$' in a title or kind is a '$'
         import matplotlib.pyplot  # noqa: F401
     except ImportError as e:
-        fail(EXIT_FAILURE, f"usv-fdi plot needs matplotlib for python3 (Debian package "
-             f"python3-matplotlib, scripts/packages.txt section [plot]): {e}")
-    rec = Records(a.input)
-    faults = fault_intervals(a.csv) if a.csv else []
+        fail(EXIT_FAILURE, f"usv-fdi plot needs matplotlib for {sys.executable} (Debian "
+             f"package python3-matplotlib, scripts/packages.txt section [plot]; another "
+             f"interpreter: USV_FDI_PYTHON): {e}")
     title = a.title or os.path.basename(a.input)
     try:
         os.makedirs(a.output, exist_ok=True)
@@ -341,4 +380,9 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except SystemExit:
+        raise
+    except Exception as e:  # anything unforeseen is named, never a traceback
+        fail(EXIT_FAILURE, f"usv-fdi plot: {type(e).__name__}: {e}")

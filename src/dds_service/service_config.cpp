@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -159,6 +160,29 @@ void add_pipeline_keys(ServiceLoad* s, ConfigValue::Table* table) {
   t["restore_recheck"] = positive_time(&p.restore_recheck);
 }
 
+}  // namespace
+
+bool is_host_port(const std::string& s) {
+  const std::size_t colon = s.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == s.size() || colon + 6 < s.size()) {
+    return false;
+  }
+  for (std::size_t i = 0; i < colon; ++i) {
+    const char c = s[i];
+    const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' ||
+                    c == '_' || c == ':' || c == '[' || c == ']';
+    if (!ok) return false;
+  }
+  long port = 0;
+  for (std::size_t i = colon + 1; i < s.size(); ++i) {
+    if (!std::isdigit(static_cast<unsigned char>(s[i]))) return false;
+    port = port * 10 + (s[i] - '0');
+  }
+  return port <= 65535;
+}
+
+namespace {
+
 /// The process's keys: log_level, state_dir, health_file, metrics.
 void add_process_keys(ServiceLoad* s, ConfigValue::Table* table) {
   ConfigValue::Table& t = *table;
@@ -170,6 +194,9 @@ void add_process_keys(ServiceLoad* s, ConfigValue::Table* table) {
   };
   t["metrics"] = [s](const ConfigValue& v) {
     s->cfg.metrics = v.is_null() ? std::string() : v.text("host:port");
+    if (!s->cfg.metrics.empty() && !is_host_port(s->cfg.metrics)) {
+      v.fail("must be HOST:PORT (an address or name, a port 0-65535; 0: any free port)");
+    }
   };
 }
 

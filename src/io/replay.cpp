@@ -115,9 +115,12 @@ class Replay {
   /// A signal record every signal_period (none when it is 0).
   void record_signal(double t) {
     if (options_.signal_period <= 0.0) return;
-    if (std::isnan(last_signal_) || t >= last_signal_ + options_.signal_period) {
+    // On the grid k * signal_period (the first sample at or after each grid time): the
+    // records do not drift with the samples' jitter.
+    const double period = options_.signal_period;
+    if (std::isnan(next_signal_) || t >= next_signal_ - 1e-6 * period) {  // round-off of k dt
       out_.signal(t, engine_.isolation_status());
-      last_signal_ = t;
+      next_signal_ = (std::floor(t / period + 1e-6) + 1.0) * period;
     }
   }
 
@@ -127,7 +130,7 @@ class Replay {
   FdiEngine engine_;
   RunSummary sum_;
   std::vector<FaultEvent> events_;
-  double first_t_ = kNaN, last_t_ = kNaN, last_record_ = kNaN, last_signal_ = kNaN;
+  double first_t_ = kNaN, last_t_ = kNaN, last_record_ = kNaN, next_signal_ = kNaN;
   bool last_converged_ = false, last_armed_ = false, last_mismatch_ = false;
   PlausibilityCheck plausible_;
   FaultState latched_[3] = {FaultState::kNormal, FaultState::kNormal, FaultState::kNormal};

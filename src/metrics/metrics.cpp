@@ -89,11 +89,13 @@ SidecarMetrics::SidecarMetrics(const std::string& bind, std::uint32_t mmsi)
                            "PauseReason bits of identification (0: identifying)", m.vessel);
   m.iso_paused =
       m.gauge("usv_fdi_isolation_paused", "PauseReason bits of isolation (0: detecting)", m.vessel);
-  const char* age_help = "Wall-clock seconds since the last sample of the input (NaN: none yet)";
+  const char* age_help = "Wall-clock seconds since the last sample of the input (+Inf: none yet)";
   m.ins_age = m.gauge("usv_fdi_input_age_seconds", age_help, m.with("input", "ins"));
   m.rudder_age = m.gauge("usv_fdi_input_age_seconds", age_help, m.with("input", "rudder"));
-  m.ins_age->Set(std::numeric_limits<double>::quiet_NaN());  // no sample yet
-  m.rudder_age->Set(std::numeric_limits<double>::quiet_NaN());
+  // No sample yet: +Inf, so that an alert on the age (usv_fdi_input_age_seconds > 5) fires
+  // for a sidecar that never heard its INS (NaN would compare false).
+  m.ins_age->Set(std::numeric_limits<double>::infinity());
+  m.rudder_age->Set(std::numeric_limits<double>::infinity());
   const char* threads[3] = {"isolation", "identification", "publisher"};
   for (int i = 0; i < 3; ++i) {
     m.thread_age[i] =
@@ -144,7 +146,7 @@ void SidecarMetrics::update(const pipeline::PipelineStatus& st,
   m.mismatch->Set(iso.model_mismatch ? 1.0 : 0.0);
   m.ident_paused->Set(st.identification_paused);
   m.iso_paused->Set(st.isolation_paused);
-  const auto age = [](double a) { return a < 0 ? std::numeric_limits<double>::quiet_NaN() : a; };
+  const auto age = [](double a) { return a < 0 ? std::numeric_limits<double>::infinity() : a; };
   m.ins_age->Set(age(live.ins_age));
   m.rudder_age->Set(age(live.rudder_age));
   m.thread_age[0]->Set(live.isolation);

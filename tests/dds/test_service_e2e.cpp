@@ -228,9 +228,16 @@ TEST(ServiceEndToEnd, MetricsEndpointServesTheRaisesAndSignalsOfThePaperScenario
     return testing_http::sample(page, name, labels);
   };
   const auto deadline = Clock::now() + seconds(15);
+  // (the raise counter is live, the other values come from the status snapshot of each
+  // status period: wait until a snapshot after the last sample has been scraped)
   do {
     page = testing_http::get(port, "/metrics");
-    if (value("usv_fdi_raises_total", "sensor", "accelerometer") == 1.0) break;
+    if (value("usv_fdi_raises_total", "sensor", "accelerometer") == 1.0 &&
+        value("usv_fdi_samples_total") >= 3400.0 &&
+        value("usv_fdi_statistic", "channel", "accelerometer") >
+            value("usv_fdi_threshold", "channel", "accelerometer")) {
+      break;
+    }
     std::this_thread::sleep_for(milliseconds(200));
   } while (Clock::now() < deadline);
   ASSERT_FALSE(page.empty()) << "no answer on port " << port << "\n" << f.log("svc");

@@ -489,8 +489,13 @@ TEST_F(Cli, PlotNamesWhatIsWrongWithItsInput) {
 
   r = plot("--input ok.jsonl --truth 1,2,x,4");
   EXPECT_EQ(r.code, 64);
-  EXPECT_TRUE(has(r.err, "not a finite number: 'x'")) << r.err;
+  EXPECT_TRUE(has(r.err,
+                  "--truth: need four finite numbers a1,a2,a3,a4 (A row-major), got "
+                  "'1,2,x,4'"))
+      << r.err;
   EXPECT_EQ(plot("--input ok.jsonl --truth 1,2,3").code, 64);
+  EXPECT_EQ(plot("--input ok.jsonl --truth 1,2,3,4,").code, 64);
+  EXPECT_EQ(plot("--input ok.jsonl --truth 0x1p0,2,3,4").code, 64);
   EXPECT_EQ(plot("--input ok.jsonl --format jpg").code, 64);
 
   spit(path("file"), "");

@@ -140,6 +140,10 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
       {"  state_dir: " + kSource + "/README.md",
        "4: service.state_dir = " + kSource + "/README.md: not a directory"},
       {"  health_file: {a: 1}", "4: service.health_file = <mapping>: must be a file path"},
+      {"  metrics: 9464", "4: service.metrics = 9464: must be HOST:PORT"},
+      {"  metrics: 127.0.0.1:99999", "4: service.metrics = 127.0.0.1:99999: must be HOST:PORT"},
+      {"  metrics: '127.0.0.1:9464,0.0.0.0:1'",
+       "4: service.metrics = 127.0.0.1:9464,0.0.0.0:1: must be HOST:PORT"},
   };
   for (const Case& c : cases) {
     const std::string path =

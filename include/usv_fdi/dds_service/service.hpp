@@ -52,6 +52,10 @@ struct ServiceConfig {
   nmea_udp::ReceiverConfig nmea;
 };
 
+/// Whether `s` is HOST:PORT as service.metrics takes it: a host name or address (IPv6 in
+/// brackets) and a port 0-65535, nothing else.
+bool is_host_port(const std::string& s);
+
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
 ///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
 ///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],

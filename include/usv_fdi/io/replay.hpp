@@ -16,8 +16,8 @@ struct ReplayOptions {
   /// Acknowledge every raised / cleared event at once (as an attentive operator would), so
   /// that each latch returns to normal when its condition clears.
   bool auto_ack = false;
-  /// A signal record (J_N, thresholds, C_a, C_g: what `usv-fdi plot` draws) at least this
-  /// often [s of data time]; 0: none.
+  /// A signal record (J_N, thresholds, C_a, C_g: what `usv-fdi plot` draws) at the first
+  /// sample at or after each multiple of this [s of data time]; 0: none.
   double signal_period = 0.0;
 };
 

@@ -19,7 +19,7 @@ namespace usvfdi::metrics {
 ///   usv_fdi_isolation_confidence{sensor}      C_a, C_g
 ///   usv_fdi_converged, usv_fdi_armed, usv_fdi_model_mismatch   0 or 1
 ///   usv_fdi_identification_paused, usv_fdi_isolation_paused   PauseReason bits (0: running)
-///   usv_fdi_input_age_seconds{input}          since the last INS / rudder sample (NaN: none yet)
+///   usv_fdi_input_age_seconds{input}          since the last INS / rudder sample (+Inf: none yet)
 ///   usv_fdi_thread_age_seconds{thread}        since each pipeline thread last went round
 ///   usv_fdi_samples_total                     samples assembled
 ///   usv_fdi_dropped_samples_total{queue}      queue overflows (input, identification, output)
