@@ -19,7 +19,8 @@ using prometheus::Counter;
 using prometheus::Gauge;
 using prometheus::Labels;
 
-constexpr const char* kSensors[2] = {"accelerometer", "gyro"};
+/// The sensor's (or residual channel's) label value: core's name of the Sensor, index i.
+const char* sensor_name(int i) { return to_string(static_cast<Sensor>(i)); }
 
 /// A counter that follows a total counted elsewhere (prometheus-cpp counters only increase).
 struct FollowedCounter {
@@ -66,20 +67,19 @@ SidecarMetrics::SidecarMetrics(const std::string& bind, std::uint32_t mmsi)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.vessel = {{"mmsi", std::to_string(mmsi)}};
-  const char* sensors3[3] = {"accelerometer", "gyro", "unknown"};
   for (int i = 0; i < 3; ++i) {
     m.raises[i].counter =
         m.counter("usv_fdi_raises_total", "Faults raised by this run of the sidecar, per sensor",
-                  m.with("sensor", sensors3[i]));
+                  m.with("sensor", sensor_name(i)));
   }
   for (int c = 0; c < 2; ++c) {
     m.statistic[c] = m.gauge("usv_fdi_statistic", "Windowed residual statistic J_N, per channel",
-                             m.with("channel", kSensors[c]));
+                             m.with("channel", sensor_name(c)));
     m.threshold[c] =
         m.gauge("usv_fdi_threshold", "Enter threshold on J_N, per channel (0 before arming)",
-                m.with("channel", kSensors[c]));
+                m.with("channel", sensor_name(c)));
     m.confidence[c] = m.gauge("usv_fdi_isolation_confidence", "Isolation confidence C_a, C_g",
-                              m.with("sensor", kSensors[c]));
+                              m.with("sensor", sensor_name(c)));
   }
   m.converged = m.gauge("usv_fdi_converged", "1 while the estimate of A has converged", m.vessel);
   m.armed = m.gauge("usv_fdi_armed", "1 while model-based detection is armed", m.vessel);
