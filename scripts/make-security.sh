@@ -25,11 +25,12 @@
 #                          VESSELS ties it to vessels (MMSIs, 1..999999999), and every right of a
 #                          vessel-bound role is confined to the vessel's partition PREFIXvessel-<MMSI>:
 #                            vessel:NAME:MMSI     the sidecar of that one vessel: publishes its fault
-#                                                 events and status, reads its INS, rudder, acks and
+#                                                 events and status, reads its INS, rudder, speed, acks and
 #                                                 its own fault events (to spot a second writer),
 #                                                 only in its own partition (required: one MMSI)
-#                            sensors:NAME:MMSI    that vessel's INS/rudder gateway: publishes INS and
-#                                                 rudder in its partition only (required: one MMSI)
+#                            sensors:NAME:MMSI    that vessel's INS/rudder gateway: publishes INS,
+#                                                 rudder and speed in its partition only
+#                                                 (required: one MMSI)
 #                            shore:NAME:M1,M2,..  reads every vessel (PREFIXvessel-*), acknowledges
 #                                                 only the vessels listed; shore:NAME:* acknowledges
 #                                                 every vessel (required: the list or *)
@@ -213,8 +214,8 @@ allow_rules() { # allow_rules ROLE VESSELS -> the <allow_rule> of the role
   every="${part_prefix}vessel-*"
   printf '      <allow_rule>\n        <domains>\n          <id_range>\n            <min>0</min>\n            <max>232</max>\n          </id_range>\n        </domains>\n'
   case "$1" in
-    vessel) rule publish "$own" fault_event status; rule subscribe "$own" ins rudder fault_ack fault_event ;;
-    sensors) rule publish "$own" ins rudder ;;
+    vessel) rule publish "$own" fault_event status; rule subscribe "$own" ins rudder speed fault_ack fault_event ;;
+    sensors) rule publish "$own" ins rudder speed ;;
     shore) rule publish "$own" fault_ack; rule subscribe "$every" fault_event status ;;
     observer) rule subscribe "$every" fault_event status ;;
   esac

@@ -71,11 +71,12 @@ struct Ros2Args {
   double diagnostics_period = 1.0;
   bool no_mirrors = false;
   bool reliable = false;
+  bool surge = false;  ///< --surge-from-sway: twist linear.x as the surge speed
 };
 
 /// One ROS 2 input sample as the listener copies it (usv-fdi signs already).
 struct Input {
-  enum Kind { kYaw, kSway, kRudder } kind = kYaw;
+  enum Kind { kYaw, kSway, kRudder, kSurge } kind = kYaw;
   double stamp = 0.0;  ///< header stamp [s] (none for the rudder)
   double value = 0.0;
   bool valid = false;
@@ -85,7 +86,8 @@ struct Input {
 /// into a bounded queue (full: the oldest is dropped and counted).
 class InputQueue : public fdds::DataReaderListener {
  public:
-  InputQueue(int rudder_sign, bool odometry) : rudder_sign_(rudder_sign), odometry_(odometry) {}
+  InputQueue(int rudder_sign, bool odometry, bool surge)
+      : rudder_sign_(rudder_sign), odometry_(odometry), surge_(surge) {}
 
   void set_readers(fdds::DataReader* yaw, fdds::DataReader* sway, fdds::DataReader* rudder) {
     std::lock_guard<std::mutex> lock(m_);
@@ -118,6 +120,7 @@ class InputQueue : public fdds::DataReaderListener {
         if (!info.valid_data) continue;
         const double y = m.twist().twist().linear().y();
         push({Input::kSway, stamp_of(m.header()), ros2::sway_from_rep103(y), std::isfinite(y)});
+        push_surge(m.header(), m.twist().twist().linear().x());
       }
     } else if (reader == sway) {
       geometry_msgs::msg::TwistStamped m;
@@ -125,6 +128,7 @@ class InputQueue : public fdds::DataReaderListener {
         if (!info.valid_data) continue;
         const double y = m.twist().linear().y();
         push({Input::kSway, stamp_of(m.header()), ros2::sway_from_rep103(y), std::isfinite(y)});
+        push_surge(m.header(), m.twist().linear().x());
       }
     } else if (reader == rudder) {
       std_msgs::msg::Float64 m;
@@ -163,10 +167,15 @@ class InputQueue : public fdds::DataReaderListener {
     }
     cv_.notify_one();
   }
+  /// REP 103: x forward, so linear.x is the surge speed with the project's sign.
+  void push_surge(const std_msgs::msg::Header& h, double x) {
+    if (surge_) push({Input::kSurge, stamp_of(h), x, std::isfinite(x)});
+  }
 
   static constexpr std::size_t kCapacity = 8192;
   const double rudder_sign_;
   const bool odometry_;
+  const bool surge_;
   mutable std::mutex m_;
   std::condition_variable cv_;
   std::deque<Input> q_;
@@ -324,6 +333,9 @@ usv_fdi_msgs::msg::FdiStatus mirror_of(const fdi::FdiStatus& s) {
   m.acks_dropped(s.acks_dropped());
   m.other_event_writers(s.other_event_writers());
   m.incarnation(s.incarnation());
+  m.surge_speed(s.surge_speed());
+  m.speed_ratio(s.speed_ratio());
+  m.reference_speed(s.reference_speed());
   return m;
 }
 
@@ -338,6 +350,11 @@ class Adapter {
     rudder_ =
         &ctx.create_writer(dds::TopicId::kRudder, rel ? dds::profiles::kRudderWriterReliable
                                                       : dds::profiles::kRudderWriterBestEffort);
+    if (a.surge) {
+      speed_ =
+          &ctx.create_writer(dds::TopicId::kSpeed, rel ? dds::profiles::kRudderWriterReliable
+                                                       : dds::profiles::kRudderWriterBestEffort);
+    }
   }
 
   void turn() {
@@ -353,10 +370,11 @@ class Adapter {
 
   std::string summary() const {
     return fmt::format(
-        "{} INS and {} rudder samples published; {} Imu, {} sway, {} rudder messages read ({} "
-        "dropped from the full input queue); {} INS samples with a stale sway velocity, {} sway "
-        "samples refused (stamp repeated, backward or not finite); {} DiagnosticArray messages",
-        ins_seq_, rudder_seq_, yaw_in_, sway_in_, rudder_in_, inputs_.dropped(),
+        "{} INS, {} rudder and {} speed samples published; {} Imu, {} sway, {} rudder messages "
+        "read ({} dropped from the full input queue); {} INS samples with a stale sway "
+        "velocity, {} sway samples refused (stamp repeated, backward or not finite); {} "
+        "DiagnosticArray messages",
+        ins_seq_, rudder_seq_, speed_seq_, yaw_in_, sway_in_, rudder_in_, inputs_.dropped(),
         assembler_.sway_stale(), assembler_.sway_rejected(), diag_sent_);
   }
 
@@ -374,6 +392,9 @@ class Adapter {
         ++sway_in_;
         if (i.valid) assembler_.add_sway(i.stamp, i.value);
         break;
+      case Input::kSurge:
+        publish_speed(i);
+        break;
       case Input::kYaw: {
         ++yaw_in_;
         ros2::YawSample y;
@@ -388,6 +409,23 @@ class Adapter {
         assembler_.add_yaw(y, now);
         break;
       }
+    }
+  }
+
+  /// The surge speed goes out as it comes (the sidecar takes the one nearest to each INS
+  /// sample's stamp).
+  void publish_speed(const Input& i) {
+    if (speed_ == nullptr || !std::isfinite(i.stamp)) return;
+    try {
+      fdi::SpeedSample d;
+      d.mmsi(a_.mmsi);
+      d.seq(++speed_seq_);
+      d.stamp(i.stamp);
+      d.u(i.valid ? i.value : 0.0);
+      d.valid(i.valid);
+      dds::write(*speed_, d);
+    } catch (const std::exception& e) {
+      if (write_failures_++ == 0) spdlog::warn("{} (further failures only counted)", e.what());
     }
   }
 
@@ -494,6 +532,8 @@ class Adapter {
   ros2::InsAssembler assembler_;
   fdds::DataWriter* ins_ = nullptr;
   fdds::DataWriter* rudder_ = nullptr;
+  fdds::DataWriter* speed_ = nullptr;  ///< --surge-from-sway only
+  std::uint64_t speed_seq_ = 0;
   double delta_ = 0.0, delta_at_ = 0.0;
   bool delta_valid_ = false, have_delta_ = false;
   std::uint64_t ins_seq_ = 0, rudder_seq_ = 0, yaw_in_ = 0, sway_in_ = 0, rudder_in_ = 0;
@@ -530,7 +570,7 @@ int run_ros2(Ros2Args& a) {
   view_args.silent_after = a.silent_after;
   view_args.status = true;  // the FdiStatus mirror
   view_args.once = true;    // FleetView prints nothing on stdout (its changes are ours to log)
-  InputQueue inputs(a.rudder_sign, a.sway_type == "odometry");
+  InputQueue inputs(a.rudder_sign, a.sway_type == "odometry", a.surge);
   std::unique_ptr<dds::DdsContext> ctx;
   std::unique_ptr<FleetView> view;
   std::unique_ptr<RosSide> ros;
@@ -545,9 +585,10 @@ int run_ros2(Ros2Args& a) {
     return kExitFailure;
   }
   spdlog::info(
-      "ros2 adapter for MMSI {}: yaw rate from {} (sensor_msgs/Imu), sway from {} ({}), rudder "
-      "from {} (std_msgs/Float64, sign {:+d}), diagnostics on /diagnostics{} (domain {}): running",
-      a.mmsi, a.imu_topic, a.sway_topic,
+      "ros2 adapter for MMSI {}: yaw rate from {} (sensor_msgs/Imu), sway{} from {} ({}), "
+      "rudder from {} (std_msgs/Float64, sign {:+d}), diagnostics on /diagnostics{} (domain "
+      "{}): running",
+      a.mmsi, a.imu_topic, a.surge ? " and surge" : "", a.sway_topic,
       a.sway_type == "odometry" ? "nav_msgs/Odometry" : "geometry_msgs/TwistStamped",
       a.rudder_topic, a.rudder_sign,
       !a.no_mirrors ? ", mirrors on /usv_fdi/fault_event and /usv_fdi/status" : "", cfg.domain_id);
@@ -608,6 +649,9 @@ void register_ros2_command(CommandRegistry& registry) {
                 "do not publish /usv_fdi/fault_event and /usv_fdi/status");
   sub->add_flag("--reliable", args.reliable,
                 "write INS and rudder samples RELIABLE (a sidecar with reliable_inputs needs it)");
+  sub->add_flag("--surge-from-sway", args.surge,
+                "also publish the sway message's linear.x (REP 103: forward) as the surge speed "
+                "on usv_fdi/speed, where the engine scales its model with it");
 }
 
 }  // namespace usvfdi::app

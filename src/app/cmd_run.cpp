@@ -274,9 +274,10 @@ int watch_until_signal(dds_service::FdiService* svc, HealthWriter* health,
     const dds_service::FdiService::Matches m = svc->matches();
     if (m != seen) {
       spdlog::info(
-          "matched: {} INS writer(s), {} rudder writer(s), {} ack writer(s), {} "
-          "fault-event reader(s), {} status reader(s)",
-          m.ins_writers, m.rudder_writers, m.ack_writers, m.event_readers, m.status_readers);
+          "matched: {} INS writer(s), {} rudder writer(s), {} speed writer(s), {} ack writer(s), "
+          "{} fault-event reader(s), {} status reader(s)",
+          m.ins_writers, m.rudder_writers, m.speed_writers, m.ack_writers, m.event_readers,
+          m.status_readers);
       seen = m;
     }
   }

@@ -87,6 +87,10 @@ bool is_classic(const std::string& scenario) {
   return scenario == "paper" || scenario == "healthy" || scenario == "faults";
 }
 
+#ifdef USV_FDI_APP_WITH_DDS
+int publish_voyages(const SimArgs& a);
+#endif
+
 /// A voyage scenario: the voyage simulator over any hull (sim_voyage.cpp).
 int run_voyage_scenario(const SimArgs& a) {
   if (!a.udp.empty()) {
@@ -98,10 +102,7 @@ int run_voyage_scenario(const SimArgs& a) {
     return kExitUsage;
   }
 #ifdef USV_FDI_APP_WITH_DDS
-  if (a.publish) {
-    spdlog::error("--publish runs the classic scenarios (paper, healthy, faults) only");
-    return kExitUsage;
-  }
+  if (a.publish) return publish_voyages(a);
   if (!a.mmsi.empty() || !a.healthy.empty()) {
     spdlog::error("--mmsi and --healthy only apply with --publish");
     return kExitUsage;
@@ -256,6 +257,60 @@ int publish_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig
   opt.speed = a.speed;
   opt.reliable = a.pub.reliable || config_reliable;
   return publish_simulation(vessels, dds, opt);
+}
+
+/// A voyage as --publish gives it: its measured samples, and its surge speed as a speed log
+/// would (SpeedSample).
+class VoyageSource : public RowSource {
+ public:
+  explicit VoyageSource(std::unique_ptr<sim::Voyage> v) : voyage_(std::move(v)) {}
+  bool next(SimRow* row, double* u) override {
+    if (!voyage_->next(&row_)) return false;
+    *row = row_;
+    *u = row_.u_true;
+    return true;
+  }
+  bool has_speed() const override { return true; }
+
+ private:
+  std::unique_ptr<sim::Voyage> voyage_;
+  sim::VoyageRow row_;
+};
+
+/// --publish with a voyage scenario: one voyage per vessel (seed + i, the same faults), with
+/// the surge speed on the speed topic.
+int publish_voyages(const SimArgs& a) {
+  if (!a.healthy.empty()) {
+    spdlog::error("--healthy applies to the classic scenarios (paper, healthy, faults) only");
+    return kExitUsage;
+  }
+  if (!a.output.empty()) {
+    spdlog::error("sim: --publish and --output do not go together");
+    return kExitUsage;
+  }
+  std::vector<std::uint32_t> mmsis;
+  const int rc = published_mmsis(a, {}, &mmsis);
+  if (rc != kExitOk) return rc;
+  PublishedVessels vessels;
+  for (std::size_t i = 0; i < mmsis.size(); ++i) {
+    std::unique_ptr<sim::Voyage> v = make_voyage(a, a.voyage, a.seed + i);
+    if (!v) return kExitUsage;
+    spdlog::info("vessel MMSI {}: {} voyage '{}', {} Hz, seed {}, U0 {:.3g} m/s", mmsis[i],
+                 a.vessel, a.scenario, a.rate_hz, a.seed + i, v->linearisation().u0);
+    vessels.emplace_back(mmsis[i], std::make_unique<VoyageSource>(std::move(v)));
+  }
+  usvfdi::dds::DdsConfig dds;
+  bool config_reliable = false;
+  try {
+    dds = make_dds_config(a.dds, &config_reliable);
+  } catch (const io::ConfigError& e) {
+    spdlog::error("{}", e.what());
+    return kExitConfig;
+  }
+  PublishOptions opt = a.pub;
+  opt.speed = a.speed;
+  opt.reliable = a.pub.reliable || config_reliable;
+  return publish_rows(std::move(vessels), a.rate_hz, dds, opt);
 }
 #endif
 

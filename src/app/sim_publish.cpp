@@ -34,16 +34,19 @@ Clock::duration wall_duration(double seconds) {
 struct Writers {
   fdds::DataWriter* ins = nullptr;
   fdds::DataWriter* rudder = nullptr;
+  fdds::DataWriter* speed = nullptr;  ///< only when a vessel has a speed
 };
 
-/// The INS and rudder writers; false (logged) when Fast DDS refuses one.
-bool create_writers(dds::DdsContext& ctx, bool reliable, Writers* w) {
+/// The INS and rudder writers (and the speed writer, with the rudder's QoS, if `speed`);
+/// false (logged) when Fast DDS refuses one.
+bool create_writers(dds::DdsContext& ctx, bool reliable, bool speed, Writers* w) {
   try {
     w->ins = &ctx.create_writer(dds::TopicId::kIns, reliable ? dds::profiles::kInsWriterReliable
                                                              : dds::profiles::kInsWriterBestEffort);
-    w->rudder = &ctx.create_writer(
-        dds::TopicId::kRudder,
-        reliable ? dds::profiles::kRudderWriterReliable : dds::profiles::kRudderWriterBestEffort);
+    const char* rudder_profile =
+        reliable ? dds::profiles::kRudderWriterReliable : dds::profiles::kRudderWriterBestEffort;
+    w->rudder = &ctx.create_writer(dds::TopicId::kRudder, rudder_profile);
+    if (speed) w->speed = &ctx.create_writer(dds::TopicId::kSpeed, rudder_profile);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return false;
@@ -102,7 +105,9 @@ class Pacing {
     const auto w0 = Clock::now();
     const Duration_t bound(10.0);
     const bool ok = w.ins->wait_for_acknowledgments(bound) == ReturnCode_t::RETCODE_OK &&
-                    w.rudder->wait_for_acknowledgments(bound) == ReturnCode_t::RETCODE_OK;
+                    w.rudder->wait_for_acknowledgments(bound) == ReturnCode_t::RETCODE_OK &&
+                    (w.speed == nullptr ||
+                     w.speed->wait_for_acknowledgments(bound) == ReturnCode_t::RETCODE_OK);
     if (!ok) ++ack_waits_failed_;
     ack_wait_max_ =
         std::max(ack_wait_max_, std::chrono::duration<double>(Clock::now() - w0).count());
@@ -126,8 +131,6 @@ class Pacing {
   double ack_wait_max_ = 0.0;  ///< the longest flow-control wait [s]
 };
 
-using Vessels = std::vector<std::pair<std::uint32_t, SimConfig>>;
-
 /// Writes one sample to DDS, counting failures in *failed (the first one logged).
 template <typename Sample>
 void write_counted(fdds::DataWriter* w, const Sample& s, std::uint64_t* failed) {
@@ -138,8 +141,22 @@ void write_counted(fdds::DataWriter* w, const Sample& s, std::uint64_t* failed) 
   }
 }
 
-void write_rudder(const Writers& w, const Vessels& vessels, const std::vector<SimRow>& rows,
-                  std::uint64_t seq, std::uint64_t* failed) {
+void write_speed(const Writers& w, const PublishedVessels& vessels, const std::vector<double>& u,
+                 const std::vector<SimRow>& rows, std::uint64_t seq, std::uint64_t* failed) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (w.speed == nullptr || std::isnan(u[i])) continue;
+    fdi::SpeedSample d;
+    d.mmsi(vessels[i].first);
+    d.seq(seq);
+    d.stamp(rows[i].t);
+    d.u(u[i]);
+    d.valid(true);
+    write_counted(w.speed, d, failed);
+  }
+}
+
+void write_rudder(const Writers& w, const PublishedVessels& vessels,
+                  const std::vector<SimRow>& rows, std::uint64_t seq, std::uint64_t* failed) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const SimRow& r = rows[i];
     fdi::RudderSample d;
@@ -152,7 +169,7 @@ void write_rudder(const Writers& w, const Vessels& vessels, const std::vector<Si
   }
 }
 
-void write_ins(const Writers& w, const Vessels& vessels, const std::vector<SimRow>& rows,
+void write_ins(const Writers& w, const PublishedVessels& vessels, const std::vector<SimRow>& rows,
                std::uint64_t seq, std::uint64_t* failed) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const SimRow& r = rows[i];
@@ -187,22 +204,25 @@ struct Published {
   bool stopped = false;      ///< by a signal
 };
 
-/// Publishes every simulation in lockstep, paced, until one ends or a stop signal comes.
-Published publish_voyage(const std::vector<std::unique_ptr<Simulator>>& sims,
-                         const Vessels& vessels, const Writers& w, const PublishOptions& opt,
-                         Clock::time_point wait_end) {
+/// Publishes every vessel's samples in lockstep, paced, until one ends or a stop signal comes.
+Published publish_voyage(const PublishedVessels& vessels, const Writers& w,
+                         const PublishOptions& opt, Clock::time_point wait_end) {
   Pacing pacing(opt.speed);
   Published out;
-  std::vector<SimRow> rows(sims.size());
+  std::vector<SimRow> rows(vessels.size());
+  std::vector<double> u(vessels.size(), kNaN);
   for (bool more = true; more && !out.stopped;) {
-    for (std::size_t i = 0; i < sims.size() && more; ++i) more = sims[i]->next(&rows[i]);
+    for (std::size_t i = 0; i < vessels.size() && more; ++i) {
+      more = vessels[i].second->next(&rows[i], &u[i]);
+    }
     if (!more) break;
     const double t = rows.front().t;
     pacing.wait_until_due(t);
     const std::uint64_t seq = ++out.seq;
     if (opt.reliable && seq > 1 && seq % kAckEvery == 0) pacing.flow_control(w);
-    // Rudder first: the sidecar pairs an INS sample with the rudder angle at its stamp and
-    // releases it as soon as a rudder sample at or after that stamp has arrived.
+    // Speed and rudder first: the sidecar pairs an INS sample with the rudder angle at its
+    // stamp and releases it as soon as a rudder sample at or after that stamp has arrived.
+    write_speed(w, vessels, u, rows, seq, &out.failed);
     write_rudder(w, vessels, rows, seq, &out.failed);
     if (seq == 1 && opt.reliable) {
       await_first_rudder_ack(w, wait_end);
@@ -225,24 +245,32 @@ void linger(const Writers& w, const PublishOptions& opt) {
   if (opt.reliable) {
     w.ins->wait_for_acknowledgments(linger);
     w.rudder->wait_for_acknowledgments(linger);
+    if (w.speed != nullptr) w.speed->wait_for_acknowledgments(linger);
   }
   (void)wait_for_stop_signal(opt.linger);
 }
 
+/// The classic simulator: no speed (its models are linear at their design speed).
+class SimulatorSource : public RowSource {
+ public:
+  explicit SimulatorSource(const SimConfig& c) : sim_(c) {}
+  bool next(SimRow* row, double* u) override {
+    *u = kNaN;
+    return sim_.next(row);
+  }
+  bool has_speed() const override { return false; }
+
+ private:
+  Simulator sim_;
+};
+
 }  // namespace
 
-int publish_simulation(const Vessels& vessels, const dds::DdsConfig& cfg,
-                       const PublishOptions& opt) {
+int publish_rows(PublishedVessels vessels, double rate_hz, const dds::DdsConfig& cfg,
+                 const PublishOptions& opt) {
   block_stop_signals();  // before Fast DDS starts its threads
   route_fastdds_log_to_spdlog();
   if (vessels.empty()) return kExitUsage;
-  std::vector<std::unique_ptr<Simulator>> sims;
-  try {
-    for (const auto& v : vessels) sims.push_back(std::make_unique<Simulator>(v.second));
-  } catch (const std::invalid_argument& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
-  }
   std::unique_ptr<dds::DdsContext> ctx;
   try {
     ctx = std::make_unique<dds::DdsContext>(cfg);
@@ -250,16 +278,33 @@ int publish_simulation(const Vessels& vessels, const dds::DdsConfig& cfg,
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
+  const bool speed = std::any_of(vessels.begin(), vessels.end(),
+                                 [](const auto& v) { return v.second->has_speed(); });
   Writers w;
-  if (!create_writers(*ctx, opt.reliable, &w)) return kExitFailure;
+  if (!create_writers(*ctx, opt.reliable, speed, &w)) return kExitFailure;
   const auto wait_end = Clock::now() + wall_duration(opt.wait_readers);
   if (!wait_for_readers(w, opt, cfg.domain_id, wait_end)) return kExitOk;
-  spdlog::info("publishing {} vessel(s) at {:g} Hz, {:g}x real time, {} writers", vessels.size(),
-               vessels.front().second.rate_hz, opt.speed,
-               opt.reliable ? "RELIABLE" : "BEST_EFFORT");
-  const Published p = publish_voyage(sims, vessels, w, opt, wait_end);
+  spdlog::info("publishing {} vessel(s) at {:g} Hz, {:g}x real time, {} writers{}", vessels.size(),
+               rate_hz, opt.speed, opt.reliable ? "RELIABLE" : "BEST_EFFORT",
+               speed ? ", with the surge speed" : "");
+  const Published p = publish_voyage(vessels, w, opt, wait_end);
   if (!p.stopped) linger(w, opt);
   return kExitOk;
+}
+
+int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,
+                       const dds::DdsConfig& cfg, const PublishOptions& opt) {
+  if (vessels.empty()) return kExitUsage;
+  PublishedVessels sources;
+  try {
+    for (const auto& v : vessels) {
+      sources.emplace_back(v.first, std::make_unique<SimulatorSource>(v.second));
+    }
+  } catch (const std::invalid_argument& e) {
+    spdlog::error("{}", e.what());
+    return kExitUsage;
+  }
+  return publish_rows(std::move(sources), vessels.front().second.rate_hz, cfg, opt);
 }
 
 }  // namespace usvfdi::app

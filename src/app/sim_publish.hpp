@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -18,9 +19,27 @@ struct PublishOptions {
   double linger = 1.0;         ///< keep the writers this long after the last sample [s]
 };
 
-/// Publishes every vessel's simulation in lockstep (all at the first vessel's rate), paced
-/// to real time x speed, until the duration ends or SIGINT/SIGTERM (blocked beforehand).
-/// Returns a process exit code.
+/// One vessel's samples for --publish: the classic simulator or a voyage.
+class RowSource {
+ public:
+  virtual ~RowSource() = default;
+  /// The next sample, and its surge speed *u [m/s] (NaN: none, no SpeedSample is written);
+  /// false once the voyage is over.
+  virtual bool next(SimRow* row, double* u) = 0;
+  /// Whether this source gives a surge speed (the speed writer is created only then).
+  virtual bool has_speed() const = 0;
+};
+
+/// Vessels to publish: each MMSI with its samples.
+using PublishedVessels = std::vector<std::pair<std::uint32_t, std::unique_ptr<RowSource>>>;
+
+/// Publishes every vessel's samples in lockstep (rate_hz: for the log), paced to real time x
+/// speed, until one source ends or SIGINT/SIGTERM (blocked beforehand): per step, each vessel's
+/// SpeedSample (where it has a speed), RudderSample, then InsSample. Returns a process exit code.
+int publish_rows(PublishedVessels vessels, double rate_hz, const usvfdi::dds::DdsConfig& dds,
+                 const PublishOptions& opt);
+
+/// publish_rows of the classic simulator (no speed).
 int publish_simulation(const std::vector<std::pair<std::uint32_t, SimConfig>>& vessels,
                        const usvfdi::dds::DdsConfig& dds, const PublishOptions& opt);
 

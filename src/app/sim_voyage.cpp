@@ -208,25 +208,35 @@ void add_voyage_options(CLI::App* sub, VoyageArgs* a) {
                   "(starboard, default, or port)");
 }
 
-int run_voyage_sim(const VoyageCommon& c, const VoyageArgs& a) {
+std::unique_ptr<sim::Voyage> make_voyage(const VoyageCommon& c, const VoyageArgs& a,
+                                         std::uint64_t seed, sim::VoyageConfig* cfg_out) {
   const auto hull = find_voyage_hull(c.vessel);
   if (!hull) {
     spdlog::error("--vessel '{}': no such hull", c.vessel);
-    return kExitUsage;
+    return nullptr;
   }
+  VoyageCommon seeded = c;
+  seeded.seed = seed;
   sim::VoyageConfig cfg;
   std::string why;
-  if (!build(c, a, *hull, &cfg, &why)) {
+  if (!build(seeded, a, *hull, &cfg, &why)) {
     spdlog::error("sim: {}", why);
-    return kExitUsage;
+    return nullptr;
   }
-  std::unique_ptr<sim::Voyage> voyage;
+  if (cfg_out != nullptr) *cfg_out = cfg;
   try {
-    voyage = std::make_unique<sim::Voyage>(hull, cfg);
+    return std::make_unique<sim::Voyage>(hull, cfg);
   } catch (const std::invalid_argument& e) {
     spdlog::error("{}", e.what());
-    return kExitUsage;
+    return nullptr;
   }
+}
+
+int run_voyage_sim(const VoyageCommon& c, const VoyageArgs& a) {
+  sim::VoyageConfig cfg;
+  std::unique_ptr<sim::Voyage> voyage = make_voyage(c, a, c.seed, &cfg);
+  if (!voyage) return kExitUsage;
+  const auto hull = find_voyage_hull(c.vessel);
   std::ofstream file;
   const bool to_stdout = c.output == "-";
   if (!to_stdout) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "usv_fdi/sim/hull.hpp"
+#include "usv_fdi/sim/voyage.hpp"
 
 namespace usvfdi::app {
 
@@ -63,6 +64,10 @@ std::vector<std::string> voyage_vessel_names();
 /// The hull of that name (the zoo's, else a shipped vessel as a linear hull); nullptr if none.
 std::shared_ptr<const sim::Hull> find_voyage_hull(const std::string& name);
 void add_voyage_options(CLI::App* sub, VoyageArgs* a);
+/// The voyage the options describe, with this seed (and its configuration in *cfg if not
+/// null); nullptr (logged) on a bad option.
+std::unique_ptr<sim::Voyage> make_voyage(const VoyageCommon& common, const VoyageArgs& a,
+                                         std::uint64_t seed, sim::VoyageConfig* cfg = nullptr);
 /// Runs the voyage and writes its CSV (or NMEA log); returns the exit code.
 int run_voyage_sim(const VoyageCommon& common, const VoyageArgs& a);
 

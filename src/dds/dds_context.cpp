@@ -52,6 +52,8 @@ std::string type_name_of(TopicId id) {
       return fdi::FaultAckPubSubType().getName();
     case TopicId::kStatus:
       return fdi::FdiStatusPubSubType().getName();
+    case TopicId::kSpeed:
+      return fdi::SpeedSamplePubSubType().getName();
   }
   fail("invalid topic id");
 }
@@ -76,6 +78,8 @@ std::string_view to_string(TopicId id) noexcept {
       return "fault_ack";
     case TopicId::kStatus:
       return "status";
+    case TopicId::kSpeed:
+      return "speed";
   }
   return "invalid";
 }
@@ -92,6 +96,8 @@ const std::string& TopicNames::operator[](TopicId id) const {
       return fault_ack;
     case TopicId::kStatus:
       return status;
+    case TopicId::kSpeed:
+      return speed;
   }
   fail("invalid topic id");
 }
@@ -146,6 +152,7 @@ DdsContext::DdsContext(DdsConfig config) : config_(std::move(config)) {
   register_type<fdi::FaultEventPubSubType>(*participant_);
   register_type<fdi::FaultAckPubSubType>(*participant_);
   register_type<fdi::FdiStatusPubSubType>(*participant_);
+  register_type<fdi::SpeedSamplePubSubType>(*participant_);
 
   for (std::size_t i = 0; i < kTopicCount; ++i) {
     const auto id = static_cast<TopicId>(i);

@@ -106,6 +106,9 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
   d.incarnation(s.incarnation);
   d.identification_paused(s.identification_paused);
   d.isolation_paused(s.isolation_paused);
+  d.surge_speed(s.surge_speed);
+  d.speed_ratio(s.estimate.speed_ratio);
+  d.reference_speed(s.estimate.reference_speed);
   std::string msg;
   // First, so that the 128 characters keep it: the residuals contradict the model.
   if (s.isolation.model_mismatch) {
@@ -142,6 +145,10 @@ pipeline::InsInput from_dds(const fdi::InsSample& s) {
 
 pipeline::RudderInput from_dds(const fdi::RudderSample& s) {
   return pipeline::RudderInput{s.stamp(), s.delta(), s.valid(), s.seq()};
+}
+
+pipeline::SpeedInput from_dds(const fdi::SpeedSample& s) {
+  return pipeline::SpeedInput{s.stamp(), s.u(), s.valid()};
 }
 
 pipeline::AckInput from_dds(const fdi::FaultAck& a) {

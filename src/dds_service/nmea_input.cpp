@@ -79,7 +79,8 @@ void NmeaInput::hand_over() {
     if (!std::isnan(a.delta)) pipeline_->push_rudder(pipeline::RudderInput{a.t, a.delta, true, 0});
     const bool v_ok = !std::isnan(a.v);
     const bool r_ok = !std::isnan(a.r);
-    if (v_ok || r_ok) pipeline_->push_ins(pipeline::InsInput{a.t, a.v, a.r, v_ok, r_ok, 0});
+    // The surge speed (VBW's water speed, else VTG's) rides with the INS sample.
+    if (v_ok || r_ok) pipeline_->push_ins(pipeline::InsInput{a.t, a.v, a.r, v_ok, r_ok, 0, a.u});
   }
 }
 
@@ -101,7 +102,7 @@ void NmeaInput::review(std::chrono::steady_clock::time_point now) {
   std::string note;
   std::set<std::string> stale_now;
   for (const nmea::StaleInput& s : d.stale()) {
-    if (s.quantity == "u") continue;  // the surge speed is optional: not the FDI's input
+    if (s.quantity == "u") continue;  // the surge speed is optional: the engine holds the last
     stale_now.insert(s.sentence);
     note += "NMEA " + s.sentence + " stale " + seconds_text(s.age_s) + " (" + s.quantity + "); ";
     if (!stale_logged_.count(s.sentence)) {

@@ -48,6 +48,10 @@ class FdiService::Listener : public DataReaderListener {
       drain<fdi::RudderSample>(*reader, [this](const fdi::RudderSample& s, const Info&) {
         return p_->push_rudder(from_dds(s));
       });
+    } else if (reader == speed_) {
+      drain<fdi::SpeedSample>(*reader, [this](const fdi::SpeedSample& s, const Info&) {
+        return p_->push_speed(from_dds(s));
+      });
     } else if (reader == ack_) {
       drain<fdi::FaultAck>(*reader, [this](const fdi::FaultAck& a, const Info& info) {
         pipeline::AckInput in = from_dds(a);
@@ -63,6 +67,7 @@ class FdiService::Listener : public DataReaderListener {
   }
   DataReader* ins_ = nullptr;
   DataReader* rudder_ = nullptr;
+  DataReader* speed_ = nullptr;
   DataReader* ack_ = nullptr;
   std::atomic<std::uint64_t> foreign{0};  ///< samples of other vessels, skipped
 
@@ -239,6 +244,10 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     listener_->rudder_ = &reader(*dds_, dds::TopicId::kRudder,
                                  cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
                                                       : dds::profiles::kRudderReaderBestEffort);
+    // The optional surge speed: a stream like the rudder's, with its QoS profiles.
+    listener_->speed_ = &reader(*dds_, dds::TopicId::kSpeed,
+                                cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
+                                                     : dds::profiles::kRudderReaderBestEffort);
   }
   // Acks are read by a participant of their own: its traffic arrives on its own port, handled
   // by its own receive thread, so a flood of acks cannot hold up (nor, through KEEP_LAST
@@ -389,6 +398,9 @@ FdiService::Matches FdiService::matches() const {
   if (listener_->rudder_ != nullptr &&
       listener_->rudder_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.rudder_writers = sub.current_count;
+  if (listener_->speed_ != nullptr &&
+      listener_->speed_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
+    m.speed_writers = sub.current_count;
   if (listener_->ack_->get_subscription_matched_status(sub) == ReturnCode_t::RETCODE_OK)
     m.ack_writers = sub.current_count;
   // Subscribers other than sidecars: not this sidecar's own EventWatch reader (same
@@ -416,7 +428,7 @@ std::uint64_t FdiService::other_event_samples() const { return watch_ ? watch_->
 void FdiService::start() {
   pipeline_->start();
   // Listeners are attached only now, so nothing arrives before the threads run.
-  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_}) {
+  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->speed_, listener_->ack_}) {
     if (r != nullptr) r->set_listener(listener_.get(), StatusMask::data_available());
   }
   event_watch_->set_listener(watch_.get(), StatusMask::data_available());
@@ -435,7 +447,8 @@ void FdiService::start() {
 void FdiService::stop() {
   if (stopped_) return;
   stopped_ = true;
-  for (DataReader* r : {listener_->ins_, listener_->rudder_, listener_->ack_, event_watch_}) {
+  for (DataReader* r :
+       {listener_->ins_, listener_->rudder_, listener_->speed_, listener_->ack_, event_watch_}) {
     if (r != nullptr) r->set_listener(nullptr);
   }
   if (nmea_) nmea_->stop();  // no more samples; its status note stays readable

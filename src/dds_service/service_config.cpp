@@ -56,7 +56,7 @@ ConfigValue::Handler positive_time(double* out) {
   };
 }
 
-/// service.topics: the five topic names, each noted where it was given.
+/// service.topics: the six topic names, each noted where it was given.
 ConfigValue::Table topic_table(ServiceLoad* s) {
   const auto topic = [s](std::string* out) {
     return [s, out](const ConfigValue& v) {
@@ -69,7 +69,8 @@ ConfigValue::Table topic_table(ServiceLoad* s) {
           {"rudder", topic(&t.rudder)},
           {"fault_event", topic(&t.fault_event)},
           {"fault_ack", topic(&t.fault_ack)},
-          {"status", topic(&t.status)}};
+          {"status", topic(&t.status)},
+          {"speed", topic(&t.speed)}};
 }
 
 /// service.qos_profiles: readable as a file now, or the operating system's reason (EISDIR:
@@ -136,7 +137,7 @@ void add_dds_keys(ServiceLoad* s, ConfigValue::Table* table) {
 }
 
 /// The pipeline's keys: estimate_wait, status_rate, authorised_operators, input_queue,
-/// rudder_wait, rudder_timeout, input_timeout, restore_recheck.
+/// rudder_wait, rudder_timeout, speed_max_age, input_timeout, restore_recheck.
 void add_pipeline_keys(ServiceLoad* s, ConfigValue::Table* table) {
   pipeline::PipelineOptions& p = s->cfg.pipeline;
   ConfigValue::Table& t = *table;
@@ -153,6 +154,7 @@ void add_pipeline_keys(ServiceLoad* s, ConfigValue::Table* table) {
   };
   t["rudder_wait"] = positive_time(&p.rudder_wait);
   t["rudder_timeout"] = positive_time(&p.rudder_timeout);
+  t["speed_max_age"] = positive_time(&p.speed_max_age);
   t["input_timeout"] = [s, &p](const ConfigValue& v) {
     positive_time (&p.input_timeout)(v);
     s->input_timeout_at = v.where();
@@ -269,7 +271,8 @@ void check_distinct_topics(const ServiceLoad& s) {
                                                               {"rudder", &t.rudder},
                                                               {"fault_event", &t.fault_event},
                                                               {"fault_ack", &t.fault_ack},
-                                                              {"status", &t.status}};
+                                                              {"status", &t.status},
+                                                              {"speed", &t.speed}};
   const auto& given = s.topics_given;
   for (std::size_t k = 0; k < given.size(); ++k) {
     const std::string key = given[k].first.substr(given[k].first.rfind('.') + 1);

@@ -34,6 +34,30 @@ void SampleAssembler::add_rudder(const RudderInput& s) {
   while (rudder_.size() > 2 && rudder_[1].stamp < oldest - timeout_) rudder_.pop_front();
 }
 
+void SampleAssembler::add_speed(const SpeedInput& s) {
+  if (!s.valid || !std::isfinite(s.stamp) || !std::isfinite(s.u)) return;
+  auto it = speed_.end();
+  while (it != speed_.begin() && std::prev(it)->stamp > s.stamp) --it;
+  speed_.insert(it, s);
+  const double oldest = ins_.empty() ? newest_ins_ : ins_.front().s.stamp;
+  while (speed_.size() > 2 && speed_[1].stamp < oldest - speed_max_age_) speed_.pop_front();
+  constexpr std::size_t kMaxSpeedSamples = 4096;  // a speed stream far ahead of the INS
+  while (speed_.size() > kMaxSpeedSamples) speed_.pop_front();
+}
+
+double SampleAssembler::speed_at(double t) const {
+  double best = kNaN, best_distance = speed_max_age_;
+  for (const SpeedInput& s : speed_) {
+    const double d = std::abs(s.stamp - t);
+    if (d <= best_distance) {
+      best = s.u;
+      best_distance = d;
+    }
+    if (s.stamp > t) break;  // sorted: the later ones are farther
+  }
+  return best;
+}
+
 double SampleAssembler::delta_at(double t) const {
   if (rudder_.empty()) return kNaN;
   std::size_t i = 0;
@@ -67,6 +91,9 @@ void SampleAssembler::rebase(double t, double span) {
   rudder_.erase(std::remove_if(rudder_.begin(), rudder_.end(),
                                [&](const RudderInput& s) { return far(s.stamp); }),
                 rudder_.end());
+  speed_.erase(std::remove_if(speed_.begin(), speed_.end(),
+                              [&](const SpeedInput& s) { return far(s.stamp); }),
+               speed_.end());
   if (far(newest_ins_)) newest_ins_ = ins_.empty() ? t : ins_.back().s.stamp;
 }
 
@@ -74,13 +101,17 @@ void SampleAssembler::drain(std::vector<Sample>* out, bool flush, double now) {
   while (!ins_.empty()) {
     const InsInput& s = ins_.front().s;
     const bool later_rudder = !rudder_.empty() && rudder_.back().stamp >= s.stamp;
+    // Once a speed stream exists, its sample of this instant too (a slower stream: the wait).
+    const bool later_speed =
+        speed_.empty() || std::isfinite(s.u) || speed_.back().stamp >= s.stamp;
     const bool waited = newest_ins_ - s.stamp >= wait_ && now - ins_.front().arrival >= wall_wait_;
-    if (!(flush || later_rudder || waited)) break;
+    if (!(flush || (later_rudder && later_speed) || waited)) break;
     Sample out_s;
     out_s.t = s.stamp;
     out_s.v = s.v_valid ? s.v : kNaN;
     out_s.r = s.r_valid ? s.r : kNaN;
     out_s.delta = delta_at(s.stamp);
+    out_s.u = std::isfinite(s.u) ? s.u : speed_at(s.stamp);
     out->push_back(out_s);
     ins_.pop_front();
   }
@@ -184,7 +215,7 @@ FdiPipeline::FdiPipeline(const EngineConfig& cfg, const PipelineOptions& opt, Ev
       ident_q_(opt.ident_capacity),
       output_(opt.output_capacity),
       iso_(cfg),
-      assembler_(opt.rudder_wait, opt.rudder_timeout, opt.rudder_wait),
+      assembler_(opt.rudder_wait, opt.rudder_timeout, opt.rudder_wait, opt.speed_max_age),
       ident_(cfg) {
   incarnation_ = opt.incarnation;
 }
@@ -280,6 +311,16 @@ void FdiPipeline::accept_ins(const InsInput& in) {
                       fmt("INS t=%.3f s arrived after t=%.3f s", in.stamp, newest_ins_stamp_));
   }
   newest_ins_stamp_ = std::max(newest_ins_stamp_, in.stamp);
+  if (std::isfinite(in.u) && !(std::abs(in.u) <= opt_.max_abs_u)) {
+    ++problems_.invalid;
+    problems_.example(
+        InputProblems::kValue,
+        fmt("surge speed %g m/s at t=%.3f s (|u| > %g) dropped", in.u, in.stamp, opt_.max_abs_u));
+    InsInput without_u = in;
+    without_u.u = kNaN;
+    assembler_.add_ins(without_u, wall_seconds());
+    return;
+  }
   assembler_.add_ins(in, wall_seconds());
 }
 
@@ -305,6 +346,24 @@ void FdiPipeline::accept_rudder(const RudderInput& in) {
   }
   if (in.valid) newest_rudder_stamp_ = std::max(newest_rudder_stamp_, in.stamp);
   assembler_.add_rudder(in);
+}
+
+void FdiPipeline::accept_speed(const SpeedInput& in) {
+  if (!in.valid) return;  // the source says it has no speed now: the engine holds the last
+  if (!std::isfinite(in.stamp)) {
+    ++problems_.bad_stamps;
+    problems_.example(InputProblems::kStamp,
+                      fmt("a speed sample with stamp %g was dropped", in.stamp));
+    return;
+  }
+  if (!(std::abs(in.u) <= opt_.max_abs_u)) {
+    ++problems_.invalid;
+    problems_.example(
+        InputProblems::kValue,
+        fmt("surge speed %g m/s at t=%.3f s (|u| > %g) dropped", in.u, in.stamp, opt_.max_abs_u));
+    return;
+  }
+  assembler_.add_speed(in);
 }
 
 void FdiPipeline::process(const Sample& s) {
@@ -352,6 +411,7 @@ void FdiPipeline::process(const Sample& s) {
   }
   ++samples_;
   last_t_ = s.t;
+  last_u_ = s.u;
   // The rudder pauses identification and isolation: say so when it starts and ends.
   const InputHealth& in = iso_.status().input;
   if (!in.delta_ok && !rudder_paused_) {
@@ -568,6 +628,7 @@ void FdiPipeline::log_ack_summary(bool force) {
 PipelineStatus FdiPipeline::make_status() {
   PipelineStatus st;
   st.stamp = last_t_;
+  st.surge_speed = last_u_;
   st.estimate = iso_.estimate();
   st.isolation = iso_.status();
   st.samples = samples_.load();
@@ -769,8 +830,10 @@ void FdiPipeline::isolation_loop() {
         last_ins = now;
         had_ins_ = true;
         if (ins_silent_.exchange(false)) log(1, "INS samples arrive again");
+      } else if (const auto* rudder = std::get_if<RudderInput>(&in)) {
+        accept_rudder(*rudder);
       } else {
-        accept_rudder(std::get<RudderInput>(in));
+        accept_speed(std::get<SpeedInput>(in));
       }
     }
     // Also without input: a sample may have waited long enough for its rudder angle now.

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,9 @@ struct MonitorStatusLine {
   unsigned long long rejected_timestamps = 0, invalid_values = 0, gaps = 0, reordered = 0,
                      dropped_inputs = 0;
   double heard_age_s = -1;
+  std::vector<double> a;  ///< A-hat, row major
+  /// The surge speed, the model's speed ratio and its reference speed (NaN: null).
+  double surge_speed = 0, speed_ratio = 0, reference_speed = 0;
   double received = 0.0;
   static bool has(const std::vector<std::string>& v, const std::string& f) {
     return std::find(v.begin(), v.end(), f) != v.end();
@@ -120,6 +124,14 @@ inline MonitorLine parse_monitor_json(const std::string& line, double received =
     s.reordered = u("reordered");
     s.dropped_inputs = u("dropped_inputs");
     s.heard_age_s = v.at("heard_age_s").num;
+    for (const js::Value& x : v.at("a").arr) s.a.push_back(x.num);
+    const auto maybe = [&](const char* key) {
+      const js::Value& x = v.at(key);
+      return x.kind == js::Value::kNumber ? x.num : std::nan("");
+    };
+    s.surge_speed = maybe("surge_speed");
+    s.speed_ratio = maybe("speed_ratio");
+    s.reference_speed = maybe("reference_speed");
     s.received = received;
   } else if (out.type == "vessel") {
     MonitorVesselChange& c = out.vessel;

@@ -122,7 +122,10 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
   const unsigned m = 257100041;
   const std::string ms = std::to_string(m);
   const std::string accel = "usv_fdi: " + ms + " accelerometer", gyro = "usv_fdi: " + ms + " gyro";
-  f.start_service("svc", f.write_service_config("svc", m), 0);
+  // The INS falls silent when the publisher ends, maybe before the acknowledgement: a stale
+  // fault raised then (input_timeout, 1 s of wall time by default) would turn the acknowledged
+  // statuses back to ERROR. This test is about the faults, so that watchdog waits longer.
+  f.start_service("svc", f.write_service_config("svc", m, {"input_timeout: 600"}), 0);
   f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "-1", "--reliable", "--silent-after", "3",
                    "--diagnostics-period", "0.5"});
   ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
@@ -208,8 +211,9 @@ TEST(Ros2EndToEnd, OdometrySwayFromSensorDataPublishersIsolatesBothFaults) {
   const std::string ms = std::to_string(m);
   const std::string accel = "usv_fdi: " + ms + " accelerometer", gyro = "usv_fdi: " + ms + " gyro";
   f.start_service("svc", f.write_service_config("svc", m), 0);
+  // (and, REP 103 x forward, its twist's linear.x as the surge speed, on usv_fdi/speed)
   f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "1", "--reliable", "--sway-type",
-                   "odometry", "--sway-topic", "/odom", "--no-mirrors"});
+                   "odometry", "--sway-topic", "/odom", "--no-mirrors", "--surge-from-sway"});
   ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
   Ros2Probe diag(f, "diag", "read-diagnostics", {});
   Seen seen;
@@ -235,6 +239,16 @@ TEST(Ros2EndToEnd, OdometrySwayFromSensorDataPublishersIsolatesBothFaults) {
   EXPECT_TRUE(seen.mirrors.empty()) << "--no-mirrors\n" << seen.text;
   ASSERT_TRUE(pub.process().wait_exit(seconds(60)).has_value()) << f.log("pub");
   diag.process().signal(SIGTERM);
+  // AND the surge speed went from the Odometry messages through the adapter to the sidecar
+  EXPECT_NE(f.log("svc").find("1 speed writer(s)"), std::string::npos) << f.log("svc");
+  f.process("ros2").signal(SIGTERM);
+  ASSERT_TRUE(f.process("ros2").wait_exit(seconds(10)).has_value());
+  const std::string log = f.log("ros2");
+  const auto at = log.find(" speed samples published");
+  ASSERT_NE(at, std::string::npos) << log;
+  const auto from = log.rfind(", ", at);
+  ASSERT_NE(from, std::string::npos) << log;
+  EXPECT_GE(std::stoul(log.substr(from + 2, at - from - 2)), 4000u) << log;  // 100 s at 50 Hz
 }
 
 }  // namespace

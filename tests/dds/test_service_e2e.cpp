@@ -205,6 +205,102 @@ void run_partial_voyage(Fleet& f, unsigned m, const std::vector<std::string>& ex
   ASSERT_TRUE(f.wait_for_log("svc", "accelerometer #1 raised", seconds(5))) << f.log("svc");
 }
 
+// ------------------------------------------------------------------ surge speed
+
+/// A nonlinear container ship (only model.B given) slows to 70 % of its speed, recovers, speeds
+/// up to 130 % and back, with course changes: published with its surge speed on usv_fdi/speed,
+/// the sidecar scales its model with it, exactly as a replay of the same voyage's CSV (column
+/// u) does, and raises no fault.
+TEST(ServiceEndToEnd, SurgeSpeedTopicReachesTheEngineAsInAReplay) {
+  Fleet f;
+  const unsigned m = 257100071;
+  const std::vector<std::string> voyage = {"--vessel", "container", "--scenario", "speed",
+                                           "--rate",   "10",        "--duration", "1000"};
+  // The hull's B as a new user gets it, with a sidecar's service section.
+  std::string model;
+  ASSERT_EQ(f.run_to_end("vessels", {"vessels", "--yaml", "container"}, seconds(20), &model, false)
+                .value_or(-1),
+            0);
+  const std::string cfg = f.dir() + "container.yaml";
+  {
+    std::ofstream c(cfg);
+    c << model << "\nservice:\n  mmsi: " << m << "\n  reliable_inputs: true\n  status_rate: 5\n"
+      << "  rudder_wait: 1.0\n  input_timeout: 600\n  state_dir: " << f.state_dir("svc") << "\n";
+  }
+  // The replay of the same voyage (same seed) from its CSV, which carries u.
+  std::vector<std::string> sim_csv = {"sim", "--output", f.dir() + "speed.csv"};
+  sim_csv.insert(sim_csv.end(), voyage.begin(), voyage.end());
+  ASSERT_EQ(f.run_to_end("sim_csv", sim_csv, seconds(60), nullptr, false).value_or(-1), 0)
+      << f.log("sim_csv");
+  // Without its last row: a status carries the estimate isolation used for the latest sample,
+  // the one identification made from every sample before it (PipelineOptions::estimate_wait).
+  {
+    std::ifstream in(f.dir() + "speed.csv");
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);) rows.push_back(line);
+    ASSERT_EQ(rows.size(), 10002u);  // the header, 0..1000 s at 10 Hz
+    rows.pop_back();
+    std::ofstream out(f.dir() + "speed-but-last.csv");
+    for (const auto& r : rows) out << r << "\n";
+  }
+  ASSERT_EQ(f.run_to_end("replay",
+                         {"replay", "--config", cfg, "--input", f.dir() + "speed-but-last.csv",
+                          "--output", f.dir() + "speed.jsonl"},
+                         seconds(60), nullptr, false)
+                .value_or(-1),
+            0)
+      << f.log("replay");
+  std::vector<double> replay_a;
+  {
+    std::ifstream in(f.dir() + "speed.jsonl");
+    std::string line, last;
+    while (std::getline(in, line)) last = line;
+    const auto summary = usvfdi::testing_json::Parser(last).parse_document();
+    ASSERT_EQ(summary.at("raised").at("accelerometer").num + summary.at("raised").at("gyro").num,
+              0.0)
+        << last;
+    for (const auto& x : summary.at("final_a").arr) replay_a.push_back(x.num);
+  }
+  ASSERT_EQ(replay_a.size(), 4u);
+
+  // WHEN the simulator publishes the voyage with its speed, 40x faster than real time
+  ChildProcess& monitor =
+      f.start("monitor", {"monitor", "--json", "--status", "--mmsi", std::to_string(m)});
+  f.start_service("svc", cfg, 1);
+  std::vector<std::string> pub = {"sim",    "--publish",       "--reliable", "--linger", "0.2",
+                                  "--mmsi", std::to_string(m), "--speed",    "40"};
+  pub.insert(pub.end(), voyage.begin(), voyage.end());
+  ChildProcess& sim = f.start("sim", pub);
+  std::vector<MonitorEvent> ev;
+  std::vector<MonitorStatus> st;
+  std::string err;
+  const bool all = read_monitor_until(
+      monitor, &ev, &st, seconds(120),
+      [&](const std::vector<MonitorEvent>&) { return !st.empty() && st.back().samples >= 10001; },
+      &err);
+  ASSERT_TRUE(all) << err << "\n" << f.log("svc") << f.log("sim");
+  const auto sim_exit = sim.wait_exit(seconds(10));
+  ASSERT_TRUE(sim_exit.has_value());
+  EXPECT_EQ(*sim_exit, 0) << f.log("sim");
+
+  // THEN the sidecar followed the speed (70 % .. 100 % of the 7 m/s at start, its reference)
+  double lowest = 1e9;
+  for (const auto& s : st) {
+    if (std::isfinite(s.speed_ratio)) lowest = std::min(lowest, s.speed_ratio);
+  }
+  EXPECT_LT(lowest, 0.8);
+  EXPECT_GT(lowest, 0.6);
+  EXPECT_NEAR(st.back().reference_speed, 7.0, 1e-9);
+  EXPECT_TRUE(std::isfinite(st.back().surge_speed));
+  // AND identified what the replay identified from the CSV's u, and raised nothing
+  ASSERT_EQ(st.back().a.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(st.back().a[i], replay_a[i], 1e-9 * std::abs(replay_a[i])) << "a" << i + 1;
+  }
+  EXPECT_TRUE(ev.empty()) << dump(ev);
+  EXPECT_NE(f.log("svc").find("1 speed writer(s)"), std::string::npos) << f.log("svc");
+}
+
 // ------------------------------------------------------------------ metrics
 
 TEST(ServiceEndToEnd, MetricsEndpointServesTheRaisesAndSignalsOfThePaperScenario) {

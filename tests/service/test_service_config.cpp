@@ -30,6 +30,8 @@ TEST(ServiceConfig, ShippedExampleLoadsWithItsDocumentedValues) {
   EXPECT_EQ(c.dds.domain_id, 0u);
   EXPECT_EQ(c.dds.participant_profile, "usv_fdi_participant");
   EXPECT_EQ(c.dds.topics.fault_event, "usv_fdi/fault_event");
+  EXPECT_EQ(c.dds.topics.speed, "usv_fdi/speed");
+  EXPECT_DOUBLE_EQ(c.pipeline.speed_max_age, 2.0);
   EXPECT_TRUE(c.dds.publisher_partitions.empty());
   EXPECT_FALSE(c.reliable_inputs);
   EXPECT_DOUBLE_EQ(c.pipeline.status_period, 1.0);

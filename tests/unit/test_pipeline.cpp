@@ -109,6 +109,43 @@ TEST(SampleAssembler, FasterThanRealTimeARudderSampleLateByMillisecondsIsStillUs
   EXPECT_DOUBLE_EQ(out.back().delta, 0.2);
 }
 
+TEST(SampleAssembler, EachInsSampleTakesTheNearestSpeedWithinItsMaxAgeAndWaitsForIt) {
+  SampleAssembler a(0.1, 0.5, 0.0, 2.0);
+  std::vector<Sample> out;
+  // No speed stream: nothing waits for one, and u is missing.
+  a.add_rudder({0.0, 0.0, true});
+  a.add_ins({0.0, 0.0, 0.0, true, true});
+  a.drain(&out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(std::isnan(out[0].u));
+  // A speed stream: the INS sample of t = 1.0 waits for a speed sample at or after it.
+  a.add_speed({0.5, 7.0, true});
+  a.add_speed({0.9, 8.0, false});   // the source says it has no speed now: ignored
+  a.add_speed({0.95, kNaN, true});  // no value: ignored
+  a.add_rudder({2.0, 0.0, true});
+  a.add_ins({1.0, 0.0, 0.0, true, true});
+  a.drain(&out);
+  EXPECT_EQ(out.size(), 1u);
+  a.add_speed({1.1, 6.0, true});
+  a.drain(&out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_DOUBLE_EQ(out[1].u, 6.0);  // 0.1 s after it, against 0.5 s before
+  // A speed the INS sample brings itself (NMEA) goes before the stream's.
+  InsInput own{1.2, 0.0, 0.0, true, true};
+  own.u = 5.5;
+  a.add_ins(own);
+  a.drain(&out);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_DOUBLE_EQ(out[2].u, 5.5);
+  // Farther than speed_max_age from every speed sample: none (the engine holds the last).
+  a.add_rudder({5.0, 0.0, true});
+  a.add_speed({6.0, 6.5, true});
+  a.add_ins({3.5, 0.0, 0.0, true, true});
+  a.drain(&out);
+  ASSERT_EQ(out.size(), 4u);
+  EXPECT_TRUE(std::isnan(out[3].u));
+}
+
 TEST(SampleAssembler, DoesNotBridgeARudderGapLongerThanTheTimeout) {
   SampleAssembler a(0.1, 0.5);
   a.add_rudder({0.0, 0.0, true});
@@ -538,6 +575,44 @@ TEST(FdiPipelineInputs, BadSamplesAreCountedFlaggedAndLoggedWithAnExample) {
         "delivered out of order", "INS t=1.030 s arrived after t=1.040 s"}) {
     EXPECT_TRUE(logged(&c, text)) << text << "\n" << all_logs(&c);
   }
+  p.stop();
+}
+
+TEST(FdiPipelineInputs, TheSurgeSpeedReachesTheEngineAndAbsurdSpeedsAreDropped) {
+  // GIVEN a running pipeline and a speed stream beside the INS and rudder samples
+  Collected c;
+  PipelineOptions opt;
+  opt.status_period = 0.05;
+  opt.input_timeout = 60.0;
+  FdiPipeline p = make(otter(), &c, opt);
+  p.start();
+  for (int k = 0; k < 50; ++k) {
+    const double t = 0.02 * k;
+    p.push_speed({t, k < 25 ? 2.0 : 1.5, true});
+    p.push_rudder({t, 0.0, true});
+    p.push_ins({t, 0.0, 0.0, true, true});
+  }
+  p.push_speed({1.0, 300.0, true});            // absurd: dropped and counted
+  p.push_speed({kNaN, 1.5, true});             // non-finite stamp
+  InsInput absurd{1.0, 0.0, 0.0, true, true};  // a speed brought by the sample itself
+  absurd.u = -80.0;
+  p.push_rudder({1.0, 0.0, true});
+  p.push_ins(absurd);
+  feed(p, 1.02, 1.5);
+  // THEN the status reports the last speed, the ratio to the first one (the reference), and
+  // the two absurd speeds and the bad stamp among the input problems
+  PipelineStatus st;
+  ASSERT_TRUE(wait_status(
+      &c, std::chrono::milliseconds(10000),
+      [](const PipelineStatus& s) { return s.samples >= 60 && s.invalid_values >= 2; }, &st))
+      << all_logs(&c);
+  EXPECT_DOUBLE_EQ(st.surge_speed, 1.5);  // feed()'s samples take the last one, within 2 s
+  EXPECT_NEAR(st.estimate.speed_ratio, 0.75, 1e-12);
+  EXPECT_DOUBLE_EQ(st.estimate.reference_speed, 2.0);
+  EXPECT_EQ(st.invalid_values, 2u);
+  EXPECT_EQ(st.rejected_timestamps, 1u);
+  EXPECT_TRUE(logged(&c, "surge speed 300 m/s at t=1.000 s (|u| > 50) dropped")) << all_logs(&c);
+  EXPECT_TRUE(logged(&c, "surge speed -80 m/s at t=1.000 s (|u| > 50) dropped")) << all_logs(&c);
   p.stop();
 }
 

@@ -33,6 +33,7 @@ struct TopicNames {
   std::string fault_event = "usv_fdi/fault_event";
   std::string fault_ack = "usv_fdi/fault_ack";
   std::string status = "usv_fdi/status";
+  std::string speed = "usv_fdi/speed";  ///< optional surge speed (data model version 3)
 
   const std::string& operator[](TopicId id) const;
 };

@@ -9,12 +9,12 @@
 
 namespace usvfdi::dds {
 
-/// The five topics of the service. The value indexes TopicNames / DdsContext::topic().
-enum class TopicId : std::size_t { kIns = 0, kRudder, kFaultEvent, kFaultAck, kStatus };
+/// The six topics of the service. The value indexes TopicNames / DdsContext::topic().
+enum class TopicId : std::size_t { kIns = 0, kRudder, kFaultEvent, kFaultAck, kStatus, kSpeed };
 
-inline constexpr std::size_t kTopicCount = 5;
+inline constexpr std::size_t kTopicCount = 6;
 
-/// Maps a generated data type to its topic and pub/sub type. Only the five types below exist.
+/// Maps a generated data type to its topic and pub/sub type. Only the six types below exist.
 template <class T>
 struct TopicTraits;
 
@@ -43,8 +43,14 @@ struct TopicTraits<fdi::FdiStatus> {
   using PubSubType = fdi::FdiStatusPubSubType;
   static constexpr TopicId kTopic = TopicId::kStatus;
 };
+template <>
+struct TopicTraits<fdi::SpeedSample> {
+  using PubSubType = fdi::SpeedSamplePubSubType;
+  static constexpr TopicId kTopic = TopicId::kSpeed;
+};
 
-/// Human-readable name of a topic id ("ins", "rudder", "fault_event", "fault_ack", "status").
+/// Human-readable name of a topic id ("ins", "rudder", "fault_event", "fault_ack", "status",
+/// "speed").
 std::string_view to_string(TopicId id) noexcept;
 
 }  // namespace usvfdi::dds

@@ -17,6 +17,7 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
                       const IsolationParams& p);
 pipeline::InsInput from_dds(const fdi::InsSample& s);
 pipeline::RudderInput from_dds(const fdi::RudderSample& s);
+pipeline::SpeedInput from_dds(const fdi::SpeedSample& s);
 /// An unknown sensor octet is passed on as is: the isolation thread refuses it with a reason.
 pipeline::AckInput from_dds(const fdi::FaultAck& a);
 

@@ -58,10 +58,10 @@ bool is_host_port(const std::string& s);
 
 /// Loads the engine keys (see usv_fdi/io/config.hpp) and the `service:` section:
 ///   mmsi, domain_id, qos_profiles (path, relative to the config file), participant_profile,
-///   topics: {ins, rudder, fault_event, fault_ack, status}, partitions: [..],
+///   topics: {ins, rudder, fault_event, fault_ack, status, speed}, partitions: [..],
 ///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level,
-///   authorised_operators: [..], input_queue, rudder_wait, rudder_timeout, input_timeout,
-///   restore_recheck, state_dir (relative to the config file; "" : no persistence), health_file,
+///   authorised_operators: [..], input_queue, rudder_wait, rudder_timeout, speed_max_age,
+///   input_timeout, restore_recheck, state_dir (relative to the config file; "" : no persistence), health_file,
 ///   metrics,
 ///   input (dds | nmea), nmea: {address, port, interface, rate, max_age, receive_buffer}.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
@@ -107,12 +107,12 @@ class FdiService {
 
   /// Matched remote endpoints (for the operator's log); all zero after stop().
   struct Matches {
-    int ins_writers = 0, rudder_writers = 0, ack_writers = 0;
+    int ins_writers = 0, rudder_writers = 0, ack_writers = 0, speed_writers = 0;
     int event_readers = 0, status_readers = 0;
     bool operator==(const Matches& o) const {
       return ins_writers == o.ins_writers && rudder_writers == o.rudder_writers &&
              ack_writers == o.ack_writers && event_readers == o.event_readers &&
-             status_readers == o.status_readers;
+             status_readers == o.status_readers && speed_writers == o.speed_writers;
     }
     bool operator!=(const Matches& o) const { return !(*this == o); }
   };

@@ -39,6 +39,17 @@ struct InsInput {
   bool v_valid = true;
   bool r_valid = true;
   std::uint64_t seq = 0;  ///< the source's sample number (InsSample.seq); 0: not numbered
+  /// Surge speed [m/s] where the source gives it with the sample (NMEA); NaN: the speed
+  /// stream's (SpeedInput), if any.
+  double u = kNaN;
+};
+
+/// The optional surge speed (SpeedSample), any rate: each INS sample takes the speed sample
+/// nearest to it in source time, within speed_max_age.
+struct SpeedInput {
+  double stamp = kNaN;  ///< source time [s]
+  double u = kNaN;      ///< [m/s]
+  bool valid = true;
 };
 
 struct RudderInput {
@@ -66,12 +77,20 @@ struct AckInput {
 /// samples with a non-finite stamp are ignored (the pipeline counts them before).
 class SampleAssembler {
  public:
-  /// wall_wait: the wall-clock part of the wait [s] (0: source time only).
-  SampleAssembler(double rudder_wait, double rudder_timeout, double wall_wait = 0.0)
-      : wait_(rudder_wait), timeout_(rudder_timeout), wall_wait_(wall_wait) {}
+  /// wall_wait: the wall-clock part of the wait [s] (0: source time only); speed_max_age:
+  /// the largest distance in source time between an INS sample and the speed it takes [s].
+  SampleAssembler(double rudder_wait, double rudder_timeout, double wall_wait = 0.0,
+                  double speed_max_age = 2.0)
+      : wait_(rudder_wait),
+        timeout_(rudder_timeout),
+        wall_wait_(wall_wait),
+        speed_max_age_(speed_max_age) {}
   /// arrival: when the sample arrived, on any monotonic wall clock [s].
   void add_ins(const InsInput& s, double arrival = 0.0);
   void add_rudder(const RudderInput& s);
+  /// A valid speed sample with a finite stamp and speed. Once one has come, an INS sample
+  /// also waits (as for its rudder angle) for a speed sample at or after its stamp.
+  void add_speed(const SpeedInput& s);
   /// Appends the samples that are ready at wall-clock time `now` (the clock of add_ins);
   /// flush = true releases everything.
   void drain(std::vector<Sample>* out, bool flush = false, double now = 0.0);
@@ -87,9 +106,11 @@ class SampleAssembler {
     double arrival;
   };
   double delta_at(double t) const;
-  double wait_, timeout_, wall_wait_;
+  double speed_at(double t) const;
+  double wait_, timeout_, wall_wait_, speed_max_age_;
   std::deque<PendingIns> ins_;      ///< sorted by stamp
   std::deque<RudderInput> rudder_;  ///< valid rudder samples, sorted by stamp
+  std::deque<SpeedInput> speed_;    ///< valid speed samples, sorted by stamp
   double newest_ins_ = -1e300;
 };
 
@@ -100,8 +121,13 @@ struct PipelineOptions {
   std::size_t output_capacity = 4096;  ///< isolation -> publisher thread
   double rudder_wait = 0.1;            ///< [s, source time and wall clock]
   double rudder_timeout = 0.5;         ///< [s, source time]
-  double input_timeout = 1.0;          ///< INS silent this long (wall clock): stale [s]
-  double status_period = 1.0;          ///< FdiStatus period (wall clock) [s]
+  /// An INS sample takes the speed sample nearest in source time within this [s]; none
+  /// there: the engine holds the last speed ratio (core/speed.hpp).
+  double speed_max_age = 2.0;
+  /// Surge speeds beyond this are dropped as absurd (counted as invalid values) [m/s].
+  double max_abs_u = 50.0;
+  double input_timeout = 1.0;  ///< INS silent this long (wall clock): stale [s]
+  double status_period = 1.0;  ///< FdiStatus period (wall clock) [s]
   /// A fault restored at start (raised or active-acknowledged) whose sensor-level condition
   /// (stale, stuck, invalid) is no longer seen for this long is cleared [s, source time];
   /// a residual fault once the re-armed detector has learned and sees none.
@@ -199,6 +225,9 @@ struct PipelineStatus {
   std::uint64_t acks_refused = 0;  ///< unauthorised, unknown sensor, stale or unknown sequence...
   std::uint64_t acks_dropped = 0;  ///< ack queue overflow (a flood), oldest dropped
   std::uint64_t incarnation = 0;   ///< this run (PipelineOptions::incarnation)
+  /// The surge speed of the last sample [m/s] (NaN: none); the ratio and the reference speed
+  /// the model is scaled with are estimate.speed_ratio and estimate.reference_speed.
+  double surge_speed = kNaN;
   /// Faults raised by this run per Sensor (published transitions into raised; a refined kind
   /// and a restored event are none).
   std::array<std::uint64_t, 3> raises{0, 0, 0};
@@ -248,6 +277,7 @@ class FdiPipeline {
     rudder_seq_.see(s.seq);
     return input_.push(s);
   }
+  bool push_speed(const SpeedInput& s) { return input_.push(s); }
   /// Acks have their own queue: they never take a sensor sample's place nor go before it.
   bool push_ack(const AckInput& a) { return acks_.push(a); }
 
@@ -280,7 +310,7 @@ class FdiPipeline {
   PipelineLiveness liveness() const;
 
  private:
-  using Input = std::variant<InsInput, RudderInput>;
+  using Input = std::variant<InsInput, RudderInput, SpeedInput>;
   using Output = std::variant<FaultEvent, PipelineStatus>;
   /// A restored active fault awaiting its re-check.
   struct Recheck {
@@ -318,6 +348,7 @@ class FdiPipeline {
   void publisher_loop();
   void accept_ins(const InsInput& in);
   void accept_rudder(const RudderInput& in);
+  void accept_speed(const SpeedInput& in);
   void process(const Sample& s);
   /// Installs the identification thread's latest estimate, if there is a new one.
   /// Waits (bounded by estimate_wait) until the identification thread has handled every
@@ -362,6 +393,7 @@ class FdiPipeline {
   std::array<std::uint64_t, 3> current_incarnation_{0, 0, 0};
   std::array<Recheck, 3> recheck_{};
   double last_t_ = kNaN;
+  double last_u_ = kNaN;  ///< surge speed of the last sample processed
   double newest_ins_stamp_ = -1e300;
   std::uint64_t seen_version_ = 0;
   InputProblems problems_;
