@@ -141,13 +141,43 @@ DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, doub
   return l;
 }
 
-VesselNotes vessel_notes(std::uint32_t isolation_paused) {
+VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_flags) {
   VesselNotes n;
   n.model_mismatch = (isolation_paused & fdi::PAUSE_MODEL_MISMATCH) != 0;
+  n.ins_silent = (input_flags & fdi::INPUT_INS_SILENT) != 0;
+  n.rudder_missing = (input_flags & fdi::INPUT_RUDDER_MISSING) != 0;
+  n.accel_unusable = (input_flags & fdi::INPUT_ACCELEROMETER_UNUSABLE) != 0;
+  n.gyro_unusable = (input_flags & fdi::INPUT_GYRO_UNUSABLE) != 0;
   return n;
 }
 
-void add_vessel_notes(const VesselNotes& notes, DiagStatus* d) {
+namespace {
+
+/// Why the sidecar cannot judge `sensor` now ("": it can).
+std::string stale_input(const VesselNotes& n, Sensor sensor) {
+  std::string why;
+  const auto add = [&why](const char* w) { why += (why.empty() ? "" : ", ") + std::string(w); };
+  if (n.ins_silent) add("no INS samples");
+  if (n.rudder_missing) add("no usable rudder angle");
+  if (n.accel_unusable && sensor == Sensor::kAccelerometer)
+    add("the accelerometer channel is stale, invalid or stuck");
+  if (n.gyro_unusable && sensor == Sensor::kGyro)
+    add("the gyro channel is stale, invalid or stuck");
+  return why;
+}
+
+}  // namespace
+
+void add_vessel_notes(const VesselNotes& notes, Sensor sensor, DiagStatus* d) {
+  if (d->level == DiagLevel::kOk || d->level == DiagLevel::kWarn) {
+    const std::string why = stale_input(notes, sensor);
+    if (!why.empty()) {
+      d->level = DiagLevel::kStale;
+      d->message =
+          "input stale (" + why + "): the sidecar cannot judge this sensor now; " + d->message;
+      return;
+    }
+  }
   if (d->level != DiagLevel::kOk || !notes.model_mismatch) return;
   d->level = DiagLevel::kWarn;
   d->message =

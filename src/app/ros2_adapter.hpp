@@ -146,15 +146,23 @@ DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, doub
 /// data whose residual passes half its threshold, and for 10 s after a clear.)
 struct VesselNotes {
   bool model_mismatch = false;  ///< isolation_paused & PAUSE_MODEL_MISMATCH
+  // Inputs the sidecar cannot judge a sensor from now (input_flags, fdi::INPUT_*).
+  bool ins_silent = false;      ///< INPUT_INS_SILENT
+  bool rudder_missing = false;  ///< INPUT_RUDDER_MISSING (FDI paused)
+  bool accel_unusable = false;  ///< INPUT_ACCELEROMETER_UNUSABLE (stale, invalid or stuck)
+  bool gyro_unusable = false;   ///< INPUT_GYRO_UNUSABLE
 };
-/// From a status's isolation pause flags (fdi::PAUSE_*).
-VesselNotes vessel_notes(std::uint32_t isolation_paused);
+/// From a status's isolation pause flags (fdi::PAUSE_*) and input flags (fdi::INPUT_*).
+VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_flags = 0);
 
 /// The statuses of one vessel: "usv_fdi: <mmsi> accelerometer" and "... gyro" always,
 /// "... unknown" once the sidecar has published that instance. hardware_id is the MMSI;
 /// values C_a, C_g, statistic (J_N), threshold, state, sequence, kind.
 /// `row_of(sensor)` gives the vessel's instance of a sensor or nullptr. A sensor that would
-/// be OK is WARN while the vessel reports a model mismatch (not a sensor fault).
+/// be OK or WARN is STALE while the heard sidecar reports its input stale (the INS silent, no
+/// usable rudder angle, or the sensor's own channel unusable: it cannot judge the sensor now;
+/// a raised fault stays ERROR); one that would be OK is WARN while the vessel reports a model
+/// mismatch (not a sensor fault).
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
                                            double silent_after, const VesselNotes& notes = {});
@@ -162,8 +170,8 @@ std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, dou
 DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,
                                double silent_after);
 
-/// A status that would be OK told what the vessel's FdiStatus adds (see vessel_diagnostics).
-void add_vessel_notes(const VesselNotes& notes, DiagStatus* d);
+/// The status of `sensor` told what the vessel's FdiStatus adds (see vessel_diagnostics).
+void add_vessel_notes(const VesselNotes& notes, Sensor sensor, DiagStatus* d);
 
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
@@ -173,7 +181,7 @@ std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, dou
     const Row* row = row_of(s);
     if (s == Sensor::kUnknown && row == nullptr) continue;
     out.push_back(instance_diagnostic(mmsi, s, row, heard_age, silent_after));
-    add_vessel_notes(notes, &out.back());
+    add_vessel_notes(notes, s, &out.back());
   }
   return out;
 }

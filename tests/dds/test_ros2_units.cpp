@@ -216,5 +216,40 @@ TEST(Ros2Diagnostics, AModelMismatchIsAWarningNotAnError) {
   EXPECT_EQ(vessel_diagnostics(257000001, none, 0.1, 5.0, other)[0].level, DiagLevel::kOk);
 }
 
+TEST(Ros2Diagnostics, AStaleInputOfAHeardSidecarIsStaleForTheSensorsItConcerns) {
+  const auto none = [](Sensor) -> const Row* { return nullptr; };
+  // GIVEN a heard sidecar whose gyro channel is unusable (INPUT_GYRO_UNUSABLE)
+  const VesselNotes gyro = vessel_notes(0, fdi::INPUT_GYRO_UNUSABLE | fdi::INPUT_GAPS);
+  auto st = vessel_diagnostics(257000001, none, 0.1, 5.0, gyro);
+  // THEN the gyro is STALE with the reason, the accelerometer still OK (a gap is no reason)
+  ASSERT_EQ(st.size(), 2u);
+  EXPECT_EQ(st[0].level, DiagLevel::kOk) << st[0].message;
+  EXPECT_EQ(st[1].level, DiagLevel::kStale);
+  EXPECT_NE(st[1].message.find("input stale (the gyro channel is stale, invalid or stuck)"),
+            std::string::npos)
+      << st[1].message;
+  // AND a silent INS or a missing rudder angle makes both STALE, with every reason
+  const VesselNotes both =
+      vessel_notes(fdi::PAUSE_MODEL_MISMATCH, fdi::INPUT_INS_SILENT | fdi::INPUT_RUDDER_MISSING |
+                                                  fdi::INPUT_ACCELEROMETER_UNUSABLE);
+  st = vessel_diagnostics(257000001, none, 0.1, 5.0, both);
+  for (const DiagStatus& d : st) EXPECT_EQ(d.level, DiagLevel::kStale) << d.name;
+  EXPECT_NE(st[0].message.find("no INS samples, no usable rudder angle, the accelerometer"),
+            std::string::npos)
+      << st[0].message;
+  // AND a raised fault stays ERROR; a cleared one (WARN) goes STALE, keeping its state
+  const Row g = row(Sensor::kGyro, FaultState::kRaised);
+  const Row a = row(Sensor::kAccelerometer, FaultState::kClearedUnacknowledged);
+  st = vessel_diagnostics(
+      257000001,
+      [&](Sensor s) -> const Row* {
+        return s == Sensor::kGyro ? &g : s == Sensor::kAccelerometer ? &a : nullptr;
+      },
+      0.1, 5.0, both);
+  EXPECT_EQ(st[0].level, DiagLevel::kStale);
+  EXPECT_NE(st[0].message.find("cleared"), std::string::npos) << st[0].message;
+  EXPECT_EQ(st[1].level, DiagLevel::kError);
+}
+
 }  // namespace
 }  // namespace usvfdi::app::ros2
