@@ -36,13 +36,38 @@ skip() { echo "SKIP: $*"; exit 77; }
 for tool in podman buildah debootstrap python3; do
   command -v "$tool" >/dev/null || skip "$tool is not installed (scripts/install-deps.sh --only container)"
 done
+for tool in ss pgrep ps; do  # iproute2, procps ([test] in scripts/packages.txt)
+  command -v "$tool" >/dev/null || skip "$tool is not installed (scripts/install-deps.sh --only test)"
+done
 
 work="$(mktemp -d /tmp/usv-fdi-images.XXXXXX)"
 containers=()
-pids=()
+pids=()  # `buildah run` clients still running
 ok=0
+descendants() {  # PID -> every process below it
+  local c
+  for c in $(pgrep -P "$1"); do echo "$c"; descendants "$c"; done
+}
+# Stops a `buildah run` and what runs in it: the program runs as another user, so it does not
+# die with the client; TERM to all, then KILL to what is left after 5 s.
+stop_run() {  # PID
+  local all p
+  all="$(descendants "$1") $1"
+  for p in $all; do kill -TERM "$p" 2>/dev/null || true; done
+  for _ in $(seq 1 50); do
+    kill -0 "$1" 2>/dev/null || break
+    sleep 0.1
+  done
+  for p in $all; do kill -KILL "$p" 2>/dev/null || true; done
+  wait "$1" 2>/dev/null || true
+}
+forget() {  # PID: waited for, no longer to be stopped at exit
+  local keep=() p
+  for p in "${pids[@]}"; do [ "$p" = "$1" ] || keep+=("$p"); done
+  pids=("${keep[@]}")
+}
 cleanup() {
-  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do stop_run "$p"; done
   for c in "${containers[@]}"; do buildah rm "$c" >/dev/null 2>&1 || true; done
   if [ "$ok" = 1 ]; then rm -rf "$work"; else echo "test-images: logs kept in $work" >&2; fi
 }
@@ -167,14 +192,14 @@ for i in "${!discovery_cmd[@]}"; do
   if [ "${discovery_cmd[i]}" = "--port" ]; then discovery_cmd[i + 1]="$port"; fi
 done
 
-new_container() {  # IMAGE NAME -> a working container of IMAGE (removed at exit)
-  local c
-  c="$(buildah from --name "$2-$$" "$1")" || fail "buildah from $1"
-  containers+=("$c")
-  echo "$c"
-}
-disc="$(new_container "$tag:discovery" usv-fdi-test-discovery)"
-side="$(new_container "$tag:runtime" usv-fdi-test-sidecar)"
+# Working containers of the images (removed at exit; made here, not in a subshell, so that
+# the list the cleanup reads has them).
+disc="$(buildah from --name "usv-fdi-test-discovery-$$" "$tag:discovery")" ||
+  fail "buildah from $tag:discovery"
+containers+=("$disc")
+side="$(buildah from --name "usv-fdi-test-sidecar-$$" "$tag:runtime")" ||
+  fail "buildah from $tag:runtime"
+containers+=("$side")
 # Every participant but the server is a client of it (as in docker/compose.yaml).
 buildah config --env "ROS_DISCOVERY_SERVER=127.0.0.1:$port" "$side"
 
@@ -193,7 +218,6 @@ mounts=(-v "$work/etc/vessel.yaml:/etc/usv-fdi/vessel.yaml:ro" -v "$work/run:/ru
 step "discovery server: ${discovery_cmd[*]}"
 buildah run --isolation chroot "$disc" -- "${discovery_cmd[@]}" >"$work/discovery.log" 2>&1 &
 pids+=($!)
-disown  # killed at exit without a job-control message
 deadline=$((SECONDS + 30))
 until ss -Hlun "sport = :$port" | grep -q .; do
   ((SECONDS < deadline)) || fail "the discovery image's server does not listen on UDP $port"
@@ -211,10 +235,15 @@ until grep -q "waiting for INS and rudder" "$work/sidecar.log"; do
   ((SECONDS < deadline)) || fail "the image's sidecar not ready after 60 s"
   sleep 0.2
 done
-# It runs as the image's user, not as root.
-owner="$(ps -o user= -C usv-fdi | sort -u | tr '\n' ' ')"
-[ "$owner" = "usv-fdi " ] || [ "$owner" = "10001 " ] ||
-  fail "the sidecar's process runs as '$owner', not as the image's user usv-fdi (10001)"
+# The image's program itself (not buildah's helpers), and it runs as the image's user.
+program=""
+for p in $(descendants "$sidecar_pid"); do
+  [ "$(ps -o comm= -p "$p")" = usv-fdi ] && program=$p
+done
+[ -n "$program" ] || fail "no usv-fdi process under the sidecar's buildah run ($sidecar_pid)"
+owner="$(ps -o uid= -p "$program" | tr -d ' ')"
+[ "$owner" = 10001 ] ||
+  fail "the sidecar's process runs as uid '$owner', not as the image's user usv-fdi (10001)"
 
 host_env=(env "FASTRTPS_DEFAULT_PROFILES_FILE=$src/docker/fleet_participants.xml"
   "ROS_DISCOVERY_SERVER=127.0.0.1:$port")
@@ -242,6 +271,7 @@ until [ "$(grep -c '"state":"raised"' "$work/monitor.json")" -ge 2 ]; do
 done
 kill -TERM "$monitor_pid" 2>/dev/null || true
 wait "$monitor_pid" 2>/dev/null || true
+forget "$monitor_pid"
 python3 - "$work/monitor.json" "$mmsi" <<'PY' || fail "the monitor's view (monitor.json above)"
 import json, sys
 path, mmsi = sys.argv[1], int(sys.argv[2])
@@ -275,15 +305,6 @@ PY
 # As `docker stop` does: SIGTERM to the container's program itself (buildah run does not pass
 # a signal on to it), which must then stop cleanly and leave a health file that says so.
 step "stop the sidecar (SIGTERM to the image's usv-fdi); the health check must fail"
-descendants() {  # PID -> every process below it
-  local c
-  for c in $(pgrep -P "$1"); do echo "$c"; descendants "$c"; done
-}
-program=""
-for p in $(descendants "$sidecar_pid"); do
-  [ "$(ps -o comm= -p "$p")" = usv-fdi ] && program=$p
-done
-[ -n "$program" ] || fail "no usv-fdi process under the sidecar's buildah run ($sidecar_pid)"
 kill -TERM "$program"
 deadline=$((SECONDS + 30))
 while kill -0 "$sidecar_pid" 2>/dev/null; do
@@ -292,6 +313,7 @@ while kill -0 "$sidecar_pid" 2>/dev/null; do
 done
 rc=0
 wait "$sidecar_pid" || rc=$?
+forget "$sidecar_pid"
 [ "$rc" = 0 ] || fail "the image's sidecar exited with status $rc after SIGTERM (see sidecar.log)"
 if buildah run --isolation chroot "${mounts[@]}" "$side" -- "${health_cmd[@]}" \
   >"$work/health-stopped.log" 2>&1; then
