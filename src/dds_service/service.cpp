@@ -244,10 +244,21 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
     listener_->rudder_ = &reader(*dds_, dds::TopicId::kRudder,
                                  cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
                                                       : dds::profiles::kRudderReaderBestEffort);
-    // The optional surge speed: a stream like the rudder's, with its QoS profiles.
-    listener_->speed_ = &reader(*dds_, dds::TopicId::kSpeed,
-                                cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
-                                                     : dds::profiles::kRudderReaderBestEffort);
+    // The optional surge speed: a stream like the rudder's, with its QoS profiles. Not having
+    // it is no reason to stop (DDS Security permissions signed before the topic existed
+    // refuse the reader): the FDI then runs without a speed, and says so.
+    try {
+      listener_->speed_ = &reader(*dds_, dds::TopicId::kSpeed,
+                                  cfg_.reliable_inputs ? dds::profiles::kRudderReaderReliable
+                                                       : dds::profiles::kRudderReaderBestEffort);
+    } catch (const std::exception& e) {
+      if (log_) {
+        log_(2, std::string("no reader of the surge speed (") + e.what() +
+                    "): running without a speed input; under DDS Security, permissions made "
+                    "before data model version 3 must be made again (scripts/make-security.sh) "
+                    "to allow it");
+      }
+    }
   }
   // Acks are read by a participant of their own: its traffic arrives on its own port, handled
   // by its own receive thread, so a flood of acks cannot hold up (nor, through KEEP_LAST

@@ -101,9 +101,11 @@ void SampleAssembler::drain(std::vector<Sample>* out, bool flush, double now) {
   while (!ins_.empty()) {
     const InsInput& s = ins_.front().s;
     const bool later_rudder = !rudder_.empty() && rudder_.back().stamp >= s.stamp;
-    // Once a speed stream exists, its sample of this instant too (a slower stream: the wait).
-    const bool later_speed =
-        speed_.empty() || std::isfinite(s.u) || speed_.back().stamp >= s.stamp;
+    // Once a speed stream exists, its sample of this instant too (a slower stream: the wait),
+    // unless the stream has stopped (nothing valid for speed_max_age).
+    const bool later_speed = speed_.empty() || std::isfinite(s.u) ||
+                             speed_.back().stamp >= s.stamp ||
+                             s.stamp - speed_.back().stamp > speed_max_age_;
     const bool waited = newest_ins_ - s.stamp >= wait_ && now - ins_.front().arrival >= wall_wait_;
     if (!(flush || (later_rudder && later_speed) || waited)) break;
     Sample out_s;

@@ -146,6 +146,25 @@ TEST(SampleAssembler, EachInsSampleTakesTheNearestSpeedWithinItsMaxAgeAndWaitsFo
   EXPECT_TRUE(std::isnan(out[3].u));
 }
 
+TEST(SampleAssembler, AStoppedSpeedStreamHoldsNoInsSampleBack) {
+  // GIVEN a speed stream that stopped at t = 1 s (speed_max_age 2 s)
+  SampleAssembler a(0.1, 0.5, 0.0, 2.0);
+  a.add_speed({1.0, 7.0, true});
+  a.add_rudder({5.0, 0.0, true});
+  std::vector<Sample> out;
+  // WHEN an INS sample comes within 2 s of its last speed, THEN it waits for a speed sample
+  a.add_ins({2.5, 0.0, 0.0, true, true});
+  a.drain(&out);
+  EXPECT_TRUE(out.empty());
+  // AND one more than 2 s after it is released at once (its rudder angle is there); the
+  // waiting one goes with it, with the last speed
+  a.add_ins({3.5, 0.0, 0.0, true, true});
+  a.drain(&out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_DOUBLE_EQ(out[0].u, 7.0);
+  EXPECT_TRUE(std::isnan(out[1].u));
+}
+
 TEST(SampleAssembler, DoesNotBridgeARudderGapLongerThanTheTimeout) {
   SampleAssembler a(0.1, 0.5);
   a.add_rudder({0.0, 0.0, true});

@@ -89,7 +89,8 @@ class SampleAssembler {
   void add_ins(const InsInput& s, double arrival = 0.0);
   void add_rudder(const RudderInput& s);
   /// A valid speed sample with a finite stamp and speed. Once one has come, an INS sample
-  /// also waits (as for its rudder angle) for a speed sample at or after its stamp.
+  /// also waits (as for its rudder angle) for a speed sample at or after its stamp, unless
+  /// the newest is more than speed_max_age older (the stream has stopped).
   void add_speed(const SpeedInput& s);
   /// Appends the samples that are ready at wall-clock time `now` (the clock of add_ins);
   /// flush = true releases everything.
