@@ -215,6 +215,22 @@ int published_mmsis(const SimArgs& a, const TargetedFaults& targeted,
   return kExitOk;
 }
 
+/// The DDS configuration and publishing options of --publish (RELIABLE also when
+/// service.reliable_inputs of --config says so); false (logged) on a configuration error.
+bool publish_setup(const SimArgs& a, usvfdi::dds::DdsConfig* dds, PublishOptions* opt) {
+  bool config_reliable = false;
+  try {
+    *dds = make_dds_config(a.dds, &config_reliable);
+  } catch (const io::ConfigError& e) {
+    spdlog::error("{}", e.what());
+    return false;
+  }
+  *opt = a.pub;
+  opt->speed = a.speed;
+  opt->reliable = a.pub.reliable || config_reliable;
+  return true;
+}
+
 /// One simulation per vessel: seed + i, without the shared faults if --healthy, with its own
 /// MMSI@ faults.
 std::vector<std::pair<std::uint32_t, SimConfig>> vessel_simulations(
@@ -246,16 +262,8 @@ int publish_classic(const SimArgs& a, const VesselModel& vessel, const SimConfig
   if (rc != kExitOk) return rc;
   const auto vessels = vessel_simulations(a, vessel, c, mmsis, targeted);
   usvfdi::dds::DdsConfig dds;
-  bool config_reliable = false;  // service.reliable_inputs of --config
-  try {
-    dds = make_dds_config(a.dds, &config_reliable);
-  } catch (const io::ConfigError& e) {
-    spdlog::error("{}", e.what());
-    return kExitConfig;
-  }
-  PublishOptions opt = a.pub;
-  opt.speed = a.speed;
-  opt.reliable = a.pub.reliable || config_reliable;
+  PublishOptions opt;
+  if (!publish_setup(a, &dds, &opt)) return kExitConfig;
   return publish_simulation(vessels, dds, opt);
 }
 
@@ -300,16 +308,8 @@ int publish_voyages(const SimArgs& a) {
     vessels.emplace_back(mmsis[i], std::make_unique<VoyageSource>(std::move(v)));
   }
   usvfdi::dds::DdsConfig dds;
-  bool config_reliable = false;
-  try {
-    dds = make_dds_config(a.dds, &config_reliable);
-  } catch (const io::ConfigError& e) {
-    spdlog::error("{}", e.what());
-    return kExitConfig;
-  }
-  PublishOptions opt = a.pub;
-  opt.speed = a.speed;
-  opt.reliable = a.pub.reliable || config_reliable;
+  PublishOptions opt;
+  if (!publish_setup(a, &dds, &opt)) return kExitConfig;
   return publish_rows(std::move(vessels), a.rate_hz, dds, opt);
 }
 #endif
