@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <string>
 #include <thread>
 
 #include "commands.hpp"
@@ -58,21 +59,25 @@ bool create_writers(dds::DdsContext& ctx, bool reliable, bool speed, Writers* w)
 /// not lost. False: a stop signal came.
 bool wait_for_readers(const Writers& w, const PublishOptions& opt, std::uint32_t domain,
                       Clock::time_point wait_end) {
-  fdds::PublicationMatchedStatus mi, mr;
-  for (;;) {
+  fdds::PublicationMatchedStatus mi, mr, ms;
+  const auto matched = [&] {
     w.ins->get_publication_matched_status(mi);
     w.rudder->get_publication_matched_status(mr);
-    if ((mi.current_count >= opt.min_readers && mr.current_count >= opt.min_readers) ||
-        Clock::now() >= wait_end) {
-      break;
-    }
+    if (w.speed != nullptr) w.speed->get_publication_matched_status(ms);
+    return mi.current_count >= opt.min_readers && mr.current_count >= opt.min_readers &&
+           (w.speed == nullptr || ms.current_count >= opt.min_readers);
+  };
+  for (;;) {
+    if (matched() || Clock::now() >= wait_end) break;
     if (wait_for_stop_signal(0.05) != 0) return false;
   }
-  if (mi.current_count < opt.min_readers || mr.current_count < opt.min_readers) {
+  if (!matched()) {
     spdlog::warn(
-        "{} INS / {} rudder reader(s) matched within {:g} s (domain {}, {} wanted); publishing "
+        "{} INS / {} rudder{} reader(s) matched within {:g} s (domain {}, {} wanted); publishing "
         "anyway",
-        mi.current_count, mr.current_count, opt.wait_readers, domain, opt.min_readers);
+        mi.current_count, mr.current_count,
+        w.speed == nullptr ? std::string() : " / " + std::to_string(ms.current_count) + " speed",
+        opt.wait_readers, domain, opt.min_readers);
   }
   return true;
 }
@@ -194,6 +199,12 @@ void await_first_rudder_ack(const Writers& w, Clock::time_point wait_end) {
   const double left = std::max(1.0, std::chrono::duration<double>(wait_end - Clock::now()).count());
   if (w.rudder->wait_for_acknowledgments(Duration_t(left)) != ReturnCode_t::RETCODE_OK) {
     spdlog::warn("the first rudder sample was not acknowledged within {:g} s", left);
+  }
+  // The first speed sample too, written just before it (a speed reader that matched this
+  // writer later than the rudder's would otherwise lose it).
+  if (w.speed != nullptr &&
+      w.speed->wait_for_acknowledgments(Duration_t(left)) != ReturnCode_t::RETCODE_OK) {
+    spdlog::warn("the first speed sample was not acknowledged within {:g} s", left);
   }
 }
 

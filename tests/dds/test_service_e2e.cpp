@@ -216,11 +216,16 @@ TEST(ServiceEndToEnd, SurgeSpeedTopicReachesTheEngineAsInAReplay) {
   const unsigned m = 257100071;
   const std::vector<std::string> voyage = {"--vessel", "container", "--scenario", "speed",
                                            "--rate",   "10",        "--duration", "1000"};
-  // The hull's B as a new user gets it, with a sidecar's service section.
+  // The hull's B as a new user gets it, at its speed of 7 m/s (the reference: by default the
+  // first speed received, which a reliable stream may lose to discovery), with a sidecar's
+  // service section.
   std::string model;
   ASSERT_EQ(f.run_to_end("vessels", {"vessels", "--yaml", "container"}, seconds(20), &model, false)
                 .value_or(-1),
             0);
+  const auto at = model.find("\nmodel:\n");
+  ASSERT_NE(at, std::string::npos) << model;
+  model.insert(at + 8, "  reference_speed: 7.0\n");
   const std::string cfg = f.dir() + "container.yaml";
   {
     std::ofstream c(cfg);
@@ -243,25 +248,38 @@ TEST(ServiceEndToEnd, SurgeSpeedTopicReachesTheEngineAsInAReplay) {
     std::ofstream out(f.dir() + "speed-but-last.csv");
     for (const auto& r : rows) out << r << "\n";
   }
-  ASSERT_EQ(f.run_to_end("replay",
-                         {"replay", "--config", cfg, "--input", f.dir() + "speed-but-last.csv",
-                          "--output", f.dir() + "speed.jsonl"},
-                         seconds(60), nullptr, false)
-                .value_or(-1),
-            0)
-      << f.log("replay");
-  std::vector<double> replay_a;
+  // And the same without the column u, to show what the speed changes.
   {
-    std::ifstream in(f.dir() + "speed.jsonl");
+    std::ifstream in(f.dir() + "speed-but-last.csv");
+    std::ofstream out(f.dir() + "no-speed.csv");
+    for (std::string line; std::getline(in, line);) {
+      std::size_t cut = 0;
+      for (int k = 0; k < 4; ++k) cut = line.find(',', cut) + 1;  // t,v,r,delta
+      out << line.substr(0, cut - 1) << "\n";
+    }
+  }
+  const auto replay = [&](const std::string& csv, std::vector<double>* a) {
+    ASSERT_EQ(f.run_to_end("replay_" + csv,
+                           {"replay", "--config", cfg, "--input", f.dir() + csv + ".csv",
+                            "--output", f.dir() + csv + ".jsonl"},
+                           seconds(60), nullptr, false)
+                  .value_or(-1),
+              0)
+        << f.log("replay_" + csv);
+    std::ifstream in(f.dir() + csv + ".jsonl");
     std::string line, last;
     while (std::getline(in, line)) last = line;
     const auto summary = usvfdi::testing_json::Parser(last).parse_document();
     ASSERT_EQ(summary.at("raised").at("accelerometer").num + summary.at("raised").at("gyro").num,
               0.0)
         << last;
-    for (const auto& x : summary.at("final_a").arr) replay_a.push_back(x.num);
-  }
-  ASSERT_EQ(replay_a.size(), 4u);
+    for (const auto& x : summary.at("final_a").arr) a->push_back(x.num);
+    ASSERT_EQ(a->size(), 4u);
+  };
+  std::vector<double> replay_a, no_speed_a;
+  replay("speed-but-last", &replay_a);
+  replay("no-speed", &no_speed_a);
+  if (HasFatalFailure()) return;
 
   // WHEN the simulator publishes the voyage with its speed, 40x faster than real time
   ChildProcess& monitor =
@@ -290,13 +308,18 @@ TEST(ServiceEndToEnd, SurgeSpeedTopicReachesTheEngineAsInAReplay) {
   }
   EXPECT_LT(lowest, 0.8);
   EXPECT_GT(lowest, 0.6);
-  EXPECT_NEAR(st.back().reference_speed, 7.0, 1e-9);
+  EXPECT_EQ(st.back().reference_speed, 7.0);
   EXPECT_TRUE(std::isfinite(st.back().surge_speed));
-  // AND identified what the replay identified from the CSV's u, and raised nothing
+  // AND identified what the replay identified from the CSV's u (to 1e-7: the first speed
+  // sample may reach it after its first INS sample was paired, which then takes the second,
+  // 2e-8 slower), where the same voyage without u ends tens of per cent away; nothing raised
   ASSERT_EQ(st.back().a.size(), 4u);
+  double without = 0;
   for (int i = 0; i < 4; ++i) {
-    EXPECT_NEAR(st.back().a[i], replay_a[i], 1e-9 * std::abs(replay_a[i])) << "a" << i + 1;
+    EXPECT_NEAR(st.back().a[i], replay_a[i], 1e-7 * std::abs(replay_a[i])) << "a" << i + 1;
+    without = std::max(without, std::abs(no_speed_a[i] / replay_a[i] - 1));
   }
+  EXPECT_GT(without, 0.1);
   EXPECT_TRUE(ev.empty()) << dump(ev);
   EXPECT_NE(f.log("svc").find("1 speed writer(s)"), std::string::npos) << f.log("svc");
 }
