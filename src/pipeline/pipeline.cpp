@@ -313,11 +313,7 @@ void FdiPipeline::accept_ins(const InsInput& in) {
                       fmt("INS t=%.3f s arrived after t=%.3f s", in.stamp, newest_ins_stamp_));
   }
   newest_ins_stamp_ = std::max(newest_ins_stamp_, in.stamp);
-  if (std::isfinite(in.u) && !(std::abs(in.u) <= opt_.max_abs_u)) {
-    ++problems_.invalid;
-    problems_.example(
-        InputProblems::kValue,
-        fmt("surge speed %g m/s at t=%.3f s (|u| > %g) dropped", in.u, in.stamp, opt_.max_abs_u));
+  if (std::isfinite(in.u) && !speed_in_range(in.u, in.stamp)) {
     InsInput without_u = in;
     without_u.u = kNaN;
     assembler_.add_ins(without_u, wall_seconds());
@@ -358,14 +354,15 @@ void FdiPipeline::accept_speed(const SpeedInput& in) {
                       fmt("a speed sample with stamp %g was dropped", in.stamp));
     return;
   }
-  if (!(std::abs(in.u) <= opt_.max_abs_u)) {
-    ++problems_.invalid;
-    problems_.example(
-        InputProblems::kValue,
-        fmt("surge speed %g m/s at t=%.3f s (|u| > %g) dropped", in.u, in.stamp, opt_.max_abs_u));
-    return;
-  }
-  assembler_.add_speed(in);
+  if (speed_in_range(in.u, in.stamp)) assembler_.add_speed(in);
+}
+
+bool FdiPipeline::speed_in_range(double u, double stamp) {
+  if (std::abs(u) <= opt_.max_abs_u) return true;
+  ++problems_.invalid;
+  problems_.example(InputProblems::kValue, fmt("surge speed %g m/s at t=%.3f s (|u| > %g) dropped",
+                                               u, stamp, opt_.max_abs_u));
+  return false;
 }
 
 void FdiPipeline::process(const Sample& s) {

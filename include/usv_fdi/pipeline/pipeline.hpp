@@ -350,6 +350,8 @@ class FdiPipeline {
   void accept_ins(const InsInput& in);
   void accept_rudder(const RudderInput& in);
   void accept_speed(const SpeedInput& in);
+  /// |u| <= max_abs_u; otherwise counts it as an invalid value, logs an example, false.
+  bool speed_in_range(double u, double stamp);
   void process(const Sample& s);
   /// Installs the identification thread's latest estimate, if there is a new one.
   /// Waits (bounded by estimate_wait) until the identification thread has handled every
