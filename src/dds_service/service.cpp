@@ -164,7 +164,8 @@ class FdiService::EventWatch : public DataReaderListener {
   std::chrono::steady_clock::time_point last_seen_{}, last_logged_{};
 };
 
-FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(std::move(log)) {
+FdiService::FdiService(const ServiceConfig& cfg, LogSink log)
+    : cfg_(cfg), log_(std::move(log)), uplink_(cfg.uplink) {
   if (cfg_.mmsi == 0) throw std::invalid_argument("service.mmsi must be set (a vessel's MMSI > 0)");
   dds_ = std::make_unique<dds::DdsContext>(cfg_.dds);
   event_writer_ = &dds_->create_writer(dds::TopicId::kFaultEvent, dds::profiles::kFaultEventWriter);
@@ -210,7 +211,9 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log) : cfg_(cfg), log_(
       }
       d.other_event_writers(watch_->writers());
     }
-    dds::write(*status_writer_, d);
+    const double now =
+        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    if (uplink_.offer(d, now) != UplinkReason::kNone) dds::write(*status_writer_, d);
   };
   // This run's incarnation: its start time (microseconds since the Unix epoch), above that
   // of every restored event even if the clock went back.
@@ -464,6 +467,21 @@ void FdiService::stop() {
   }
   if (nmea_) nmea_->stop();  // no more samples; its status note stays readable
   pipeline_->stop();         // drains the queues; the publisher thread writes the last events
+  if (log_ && uplink_.offered() > 0) {
+    const auto n = [this](UplinkReason r) {
+      return static_cast<unsigned long long>(uplink_.sent(r));
+    };
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "status uplink (%s): %llu of %llu statuses sent (first %llu, discrete %llu, "
+                  "continuous %llu, heartbeat %llu)",
+                  cfg_.uplink.event ? "event" : "periodic",
+                  static_cast<unsigned long long>(uplink_.sent_total()),
+                  static_cast<unsigned long long>(uplink_.offered()), n(UplinkReason::kFirst),
+                  n(UplinkReason::kDiscrete), n(UplinkReason::kContinuous),
+                  n(UplinkReason::kHeartbeat));
+    log_(1, line);
+  }
   ack_dds_.reset();
   dds_.reset();  // delete_contained_entities(), then the participant
 }

@@ -137,7 +137,7 @@ void add_dds_keys(ServiceLoad* s, ConfigValue::Table* table) {
 }
 
 /// The pipeline's keys: estimate_wait, status_rate, authorised_operators, input_queue,
-/// rudder_wait, rudder_timeout, speed_max_age, input_timeout, restore_recheck.
+/// rudder_wait, rudder_timeout, speed_max_age, input_timeout, restore_recheck, status_uplink.
 void add_pipeline_keys(ServiceLoad* s, ConfigValue::Table* table) {
   pipeline::PipelineOptions& p = s->cfg.pipeline;
   ConfigValue::Table& t = *table;
@@ -160,6 +160,33 @@ void add_pipeline_keys(ServiceLoad* s, ConfigValue::Table* table) {
     s->input_timeout_at = v.where();
   };
   t["restore_recheck"] = positive_time(&p.restore_recheck);
+  t["status_uplink"] = [s](const ConfigValue& v) {
+    if (v.is_null()) v.fail("must be a mapping (mode, heartbeat, tolerance, theta, decay)");
+    UplinkOptions& u = s->cfg.uplink;
+    ConfigValue::Table keys;
+    keys["mode"] = [&u](const ConfigValue& a) {
+      const std::string m = a.text("event or periodic");
+      if (m != "event" && m != "periodic") {
+        a.fail(
+            "must be event (a status when something changes, and a heartbeat) or periodic "
+            "(every status_rate period)");
+      }
+      u.event = m == "event";
+    };
+    keys["heartbeat"] = [&u](const ConfigValue& a) {
+      u.heartbeat = a.number(1e-3, 3600.0, "a time in s", "0.001 to 3600 s");
+    };
+    keys["tolerance"] = [&u](const ConfigValue& a) {
+      u.tolerance = a.number(1e-6, 10.0, "a relative deviation", "1e-6 to 10");
+    };
+    keys["theta"] = [&u](const ConfigValue& a) {
+      u.theta = a.number(1e-6, 1e12, "a positive weight", "1e-6 to 1e12");
+    };
+    keys["decay"] = [&u](const ConfigValue& a) {
+      u.decay = a.number(0.0, 0.999, "a factor", "0 to 0.999");
+    };
+    v.section(keys);
+  };
 }
 
 }  // namespace

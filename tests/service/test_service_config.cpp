@@ -46,6 +46,9 @@ TEST(ServiceConfig, ShippedExampleLoadsWithItsDocumentedValues) {
   EXPECT_EQ(c.health_file, "");
   EXPECT_EQ(c.metrics, "");  // no Prometheus endpoint unless asked
   EXPECT_DOUBLE_EQ(c.pipeline.restore_recheck, 5.0);
+  // Statuses are event-triggered, with a heartbeat.
+  EXPECT_TRUE(c.uplink.event);
+  EXPECT_DOUBLE_EQ(c.uplink.heartbeat, 3.0);
 }
 
 TEST(ServiceConfig, EveryServiceKeyIsApplied) {
@@ -69,8 +72,14 @@ service:
   state_dir: state
   health_file: /run/usv-fdi/health.json
   metrics: 0.0.0.0:9464
+  status_uplink: {mode: periodic, heartbeat: 2, tolerance: 0.05, theta: 3, decay: 0.5}
 )");
   const ServiceConfig c = load_service_config(path);
+  EXPECT_FALSE(c.uplink.event);
+  EXPECT_DOUBLE_EQ(c.uplink.heartbeat, 2.0);
+  EXPECT_DOUBLE_EQ(c.uplink.tolerance, 0.05);
+  EXPECT_DOUBLE_EQ(c.uplink.theta, 3.0);
+  EXPECT_DOUBLE_EQ(c.uplink.decay, 0.5);
   EXPECT_EQ(c.mmsi, 123456789u);
   EXPECT_EQ(c.dds.domain_id, 42u);
   EXPECT_EQ(c.dds.participant_profile, "usv_fdi_participant_shm");
@@ -116,6 +125,11 @@ TEST(ServiceConfig, MistakesNameFileLineKeyAndValue) {
       {"  domain_id: 233", "4: service.domain_id = 233: must be 0..232"},
       {"  domain_id: x", "4: service.domain_id = x: must be an integer"},
       {"  status_rate: 0", "4: service.status_rate = 0: must be a positive rate"},
+      {"  status_uplink: {mode: sometimes}",
+       "4: service.status_uplink.mode = sometimes: must be event"},
+      {"  status_uplink: {heartbeat: 0}", "4: service.status_uplink.heartbeat = 0: must be"},
+      {"  status_uplink: {decay: 1}", "4: service.status_uplink.decay = 1: must be"},
+      {"  status_uplink: {burst: 1}", "4: service.status_uplink.burst"},
       {"  log_level: loud", "4: service.log_level = loud: must be one of"},
       {"  partitions: fleet", "4: service.partitions = fleet: must be a list"},
       {"  topics: {ins: a, radar: b}", "4: service.topics.radar = b: unknown topic"},

@@ -12,6 +12,7 @@
 #include "usv_fdi/dds/dds_context.hpp"
 #include "usv_fdi/dds_service/journal.hpp"
 #include "usv_fdi/dds_service/nmea_input.hpp"
+#include "usv_fdi/dds_service/status_uplink.hpp"
 #include "usv_fdi/nmea_udp/udp.hpp"
 #include "usv_fdi/pipeline/pipeline.hpp"
 
@@ -50,6 +51,8 @@ struct ServiceConfig {
   /// service.nmea (input: nmea): the socket and the sample assembler; the rudder sign is
   /// model.B's (nmea::rudder_sign_from_b2).
   nmea_udp::ReceiverConfig nmea;
+  /// service.status_uplink: which statuses are sent (event-triggered by default).
+  UplinkOptions uplink;
 };
 
 /// Whether `s` is HOST:PORT as service.metrics takes it: a host name or address (IPv6 in
@@ -61,7 +64,8 @@ bool is_host_port(const std::string& s);
 ///   topics: {ins, rudder, fault_event, fault_ack, status, speed}, partitions: [..],
 ///   reliable_inputs, content_filter, estimate_wait [s], status_rate [Hz], log_level,
 ///   authorised_operators: [..], input_queue, rudder_wait, rudder_timeout, speed_max_age,
-///   input_timeout, restore_recheck, state_dir (relative to the config file; "" : no persistence), health_file,
+///   input_timeout, restore_recheck, status_uplink: {mode, heartbeat, tolerance, theta, decay},
+///   state_dir (relative to the config file; "" : no persistence), health_file,
 ///   metrics,
 ///   input (dds | nmea), nmea: {address, port, interface, rate, max_age, receive_buffer}.
 /// state_dir defaults to kDefaultStateDir (used if it exists).
@@ -140,7 +144,8 @@ class FdiService {
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<NmeaInput> nmea_;  ///< input: nmea (the INS and rudder readers are not made)
   std::unique_ptr<EventWatch> watch_;
-  int lock_fd_ = -1;  ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
+  StatusUplink uplink_;  ///< the publisher thread's, then stop()'s
+  int lock_fd_ = -1;     ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
   std::unique_ptr<usvfdi::dds::DdsContext> dds_;
   /// The participant of the ack reader alone (its own port and receive thread).
   std::unique_ptr<usvfdi::dds::DdsContext> ack_dds_;
