@@ -95,4 +95,25 @@ bool read_monitor_until(ChildProcess& monitor, std::vector<MonitorEvent>* events
   return true;
 }
 
+/// Reads monitor lines until a status of each of `mmsis` has counted at least `samples` samples:
+/// a sidecar's status uplink sends the final count with its next heartbeat (within 3 s by
+/// default), not at once.
+inline bool read_until_samples(ChildProcess& monitor, std::vector<MonitorEvent>* events,
+                               std::vector<MonitorStatus>* statuses,
+                               const std::vector<unsigned>& mmsis, unsigned long long samples,
+                               std::chrono::milliseconds timeout, std::string* error) {
+  return read_monitor_until(
+      monitor, events, statuses, timeout,
+      [&](const std::vector<MonitorEvent>&) {
+        for (unsigned m : mmsis) {
+          bool seen = false;
+          for (const MonitorStatus& s : *statuses)
+            seen = seen || (s.mmsi == m && s.samples >= samples);
+          if (!seen) return false;
+        }
+        return true;
+      },
+      error);
+}
+
 }  // namespace usvfdi::dds::test

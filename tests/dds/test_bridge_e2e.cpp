@@ -191,7 +191,8 @@ TEST(BridgeEndToEnd, PaperScenarioAlertsFollowTheLifecycleAndAcnAcknowledges) {
   const unsigned m = 257100031;
   Udp bam_rx, bam_tx;
   const int acn_in = free_port();
-  f.start_service("svc", f.write_service_config("svc", m), 0);
+  // Statuses at least every 0.5 s: the bridge calls a vessel silent after 2 s.
+  f.start_service("svc", f.write_service_config("svc", m, {"status_uplink: {heartbeat: 0.5}"}), 0);
   f.start("bridge", {"bridge", "--mmsi", std::to_string(m), "--out", bam_rx.endpoint(), "--in",
                      "127.0.0.1:" + std::to_string(acn_in), "--hbt-period", "0.5", "--alc-period",
                      "1", "--ack-timeout", "5", "--silent-after", "2"});

@@ -125,7 +125,10 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
   // The INS falls silent when the publisher ends, maybe before the acknowledgement: a stale
   // fault raised then (input_timeout, 1 s of wall time by default) would turn the acknowledged
   // statuses back to ERROR. This test is about the faults, so that watchdog waits longer.
-  f.start_service("svc", f.write_service_config("svc", m, {"input_timeout: 600"}), 0);
+  // Statuses at least every second: the adapter calls a vessel silent after 3 s.
+  f.start_service(
+      "svc",
+      f.write_service_config("svc", m, {"input_timeout: 600", "status_uplink: {heartbeat: 1}"}), 0);
   f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "-1", "--reliable", "--silent-after", "3",
                    "--diagnostics-period", "0.5"});
   ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");

@@ -132,6 +132,8 @@ TEST(ServiceEndToEnd, PaperScenarioRaisesIsolatesAndClearsBothFaults) {
   const auto sim_exit = sim.wait_exit(seconds(10));
   ASSERT_TRUE(sim_exit.has_value());
   EXPECT_EQ(*sim_exit, 0) << f.log("sim");
+  // (the count of the last samples comes with the next heartbeat)
+  read_until_samples(monitor, &ev, &st, {m}, 5000, seconds(10), &err);
   std::printf("paper scenario over DDS: %.1f s wall\n",
               std::chrono::duration<double>(Clock::now() - t_start).count());
 
@@ -677,10 +679,8 @@ TEST(ServiceEndToEnd, TwoVesselsTwoSidecarsOneMonitorNoCrosstalk) {
   const auto sim_exit = sim.wait_exit(seconds(10));
   ASSERT_TRUE(sim_exit.has_value());
   EXPECT_EQ(*sim_exit, 0) << f.log("sim");
-  // Let the last status (every 0.2 s) report the complete voyage.
-  std::this_thread::sleep_for(milliseconds(600));
-  read_monitor_until(
-      monitor, &ev, &st, milliseconds(500), [](const auto&) { return false; }, &err);
+  // Let the last status (the next heartbeat, within 3 s) report the complete voyage.
+  read_until_samples(monitor, &ev, &st, {m1, m2}, 5000, seconds(10), &err);
 
   // THEN the fleet monitor sees each vessel's own faults, and nothing else
   expect_fault_episode(of(ev, m1, "gyro"), "gyro", 20.0, 40.0, dump(ev));
@@ -817,11 +817,13 @@ std::string joined(const MonitorOutput& o) {
 }
 
 TEST(ServiceEndToEnd, AStoppedSidecarIsReportedSilentLongBeforeItsLeaseExpiresAndHeardAgain) {
-  // GIVEN a sidecar (status_rate 5, no INS: it only publishes its status) and two monitors
-  // flagging a vessel silent after 2 s, one with --status, one showing fault events only
+  // GIVEN a sidecar (status_rate 5, no INS: it only publishes its status, with a heartbeat every
+  // 0.5 s) and two monitors flagging a vessel silent after 2 s, one with --status, one showing
+  // fault events only
   Fleet f;
   const unsigned m = 257100011;
-  const std::string cfg = f.write_service_config("svc", m, {"input_timeout: 60"});
+  const std::string cfg =
+      f.write_service_config("svc", m, {"input_timeout: 60", "status_uplink: {heartbeat: 0.5}"});
   ChildProcess& with_status =
       f.start("mon_status", {"monitor", "--json", "--status", "--silent-after", "2"});
   ChildProcess& events_only = f.start("mon_events", {"monitor", "--json", "--silent-after", "2"});

@@ -157,7 +157,9 @@ ChildProcess& ServiceFleet::start_sidecar(unsigned i, const std::vector<std::str
     // The compose file runs config/scenarios/paper.yaml as it is; the test adds a faster status
     // (the test reads counters from it) and an input timeout that a loaded machine cannot trip.
     f << slurp(kSource + "/config/scenarios/paper.yaml");
-    f << "\nservice:\n  status_rate: 5\n  input_timeout: 60\n  rudder_wait: 1.0\n";
+    // A status at least every second (the partition test times the shore's silent verdict).
+    f << "\nservice:\n  status_rate: 5\n  status_uplink: {heartbeat: 1}\n  input_timeout: 60\n"
+      << "  rudder_wait: 1.0\n";
     for (const auto& line : extra_yaml) f << "  " << line << "\n";
     if (!f) throw std::runtime_error("cannot write " + cfg);
   }
