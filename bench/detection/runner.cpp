@@ -206,6 +206,8 @@ std::vector<Subject> zoo_subjects() {
   return out;
 }
 
+}  // namespace
+
 sim::VoyageConfig voyage_config(const sim::Hull& hull, const std::string& voyage) {
   sim::VoyageConfig c;
   if (voyage == "course/calm") {
@@ -224,6 +226,8 @@ sim::VoyageConfig voyage_config(const sim::Hull& hull, const std::string& voyage
   }
   return c;
 }
+
+namespace {
 
 /// 5 s before the first leg that begins at or after t (legs by their nominal durations,
 /// repeated as the voyage repeats them).

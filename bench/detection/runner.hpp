@@ -14,8 +14,15 @@
 #include "drivers.hpp"
 #include "scoring.hpp"
 #include "usv_fdi/core/engine.hpp"
+#include "usv_fdi/sim/voyage.hpp"
 
 namespace usvfdi::bench {
+
+/// A voyage of the proving ground for a hull, without rate, length, seed or faults:
+/// "course/calm" (+-10 deg course changes, ideal sensors) or "voyage/sea3/mems" (every
+/// manoeuvre, sea state 3, wind, current, MEMS-grade sensors). Throws std::invalid_argument on
+/// another name.
+sim::VoyageConfig voyage_config(const sim::Hull& hull, const std::string& voyage);
 
 /// The data of one run: what the detectors see, and the faults put into it.
 struct Stream {
