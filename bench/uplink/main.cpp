@@ -20,15 +20,18 @@
 // and on the wire (payload plus the RTPS and UDP/IPv4 framing of one DATA message per sample,
 // the piggybacked HEARTBEAT and the reader's ACKNACK, constants below); what the shore knows:
 // the worst and 99th-percentile relative deviation of its last A-hat from the sidecar's, the
-// evaluations at which a discrete field differed, and the longest time without a status (the
-// silent-vessel verdict comes silent_after after the last status heard: a vessel that stops is
-// flagged no later than before, never earlier than the longest gap allows).
+// evaluations at which the state it shows differed from the sidecar's (detector and input
+// state, flags, pause reasons, the message word for word: compared field by field, not with the
+// uplink's own rule), and the longest time without a status (evaluations a second apart give or
+// take 50 ms, like the sidecar's wall clock; the silent-vessel verdict comes silent_after after
+// the last status heard, so a vessel that stops is flagged no later than before).
 // Exit code 0 when it completed (the 50 % target is reported, not enforced), 1 on error.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -81,6 +84,16 @@ struct Tally {
   std::vector<double> a_dev;
 };
 
+/// What the shore shows as the vessel's state, compared field by field (not with the uplink's
+/// own rule): detector and input state, flags, pause reasons and the message word for word.
+bool same_state(const fdi::FdiStatus& a, const fdi::FdiStatus& b) {
+  return a.converged() == b.converged() && a.armed() == b.armed() &&
+         a.ins_healthy() == b.ins_healthy() && a.rudder_healthy() == b.rudder_healthy() &&
+         a.input_flags() == b.input_flags() &&
+         a.identification_paused() == b.identification_paused() &&
+         a.isolation_paused() == b.isolation_paused() && a.message() == b.message();
+}
+
 double a_deviation(const fdi::FdiStatus& shore, const fdi::FdiStatus& s) {
   double num = 0.0, den = 0.0;
   for (int i = 0; i < 4; ++i) {
@@ -129,6 +142,8 @@ void run(const std::string& hull_name, bool faults, const EngineConfig& base, do
   std::vector<FaultEvent> out;
   sim::VoyageRow row;
   double next_tick = 1.0, last_u = kNaN, t_end = 0.0;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
   std::uint64_t samples = 0;
   const auto count_event = [&](const FaultEvent& e) {
     ++events;
@@ -149,7 +164,8 @@ void run(const std::string& hull_name, bool faults, const EngineConfig& base, do
       }
     }
     if (row.t < next_tick) continue;
-    const double tick = next_tick;  // the evaluation instant (the sidecar's wall clock)
+    // The evaluation instant: the sidecar's wall clock, a second apart give or take 50 ms.
+    const double tick = next_tick + jitter(rng);
     next_tick += 1.0;
     // The status the sidecar's publisher makes every second (PipelineStatus, pipeline.cpp).
     pipeline::PipelineStatus ps;
@@ -182,7 +198,7 @@ void run(const std::string& hull_name, bool faults, const EngineConfig& base, do
         t.payload += p;
         t.wire += kDataFraming + padded(p) + kAckNack;
       }
-      if (StatusUplink::discrete_change(t.shore, d)) ++t.discrete_differs;
+      if (!same_state(t.shore, d)) ++t.discrete_differs;
       t.a_dev.push_back(a_deviation(t.shore, d));
     }
   }
@@ -196,7 +212,7 @@ void run(const std::string& hull_name, bool faults, const EngineConfig& base, do
       "| uplink | statuses/h | first / discrete / continuous (of which A-hat) / heartbeat | status "
       "payload "
       "B/h | status wire B/h | vs periodic (payload, wire) | status+events wire B/h | "
-      "A-hat deviation p99 / max | discrete differs | longest gap [s] |\n");
+      "A-hat deviation p99 / max | state differs | longest gap [s] |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   const Tally& per = tallies[0];
   for (const Tally& t : tallies) {

@@ -223,13 +223,16 @@ int create_service(const dds_service::ServiceConfig& cfg, HealthWriter* health,
 void log_started(const dds_service::ServiceConfig& cfg, const dds_service::FdiService& svc) {
   spdlog::info(
       "sidecar for MMSI {} (incarnation {}) on DDS domain {} (participant profile {}, QoS {}, "
-      "{} inputs, status every {:g} s, state {}, health file {}): waiting for INS and rudder",
+      "{} inputs, status made every {:g} s and sent {}, state {}, health file {}): waiting for "
+      "INS and rudder",
       cfg.mmsi, svc.incarnation(), cfg.dds.domain_id, cfg.dds.participant_profile,
       cfg.dds.profiles_file,
       cfg.input == dds_service::InputSource::kNmea ? "NMEA 0183 over UDP"
       : cfg.reliable_inputs                        ? "RELIABLE"
                                                    : "BEST_EFFORT",
       cfg.pipeline.status_period,
+      cfg.uplink.event ? fmt::format("on change with a {:g} s heartbeat", cfg.uplink.heartbeat)
+                       : std::string("every time"),
       svc.state_file().empty() ? std::string("not persisted") : svc.state_file(),
       cfg.health_file.empty() ? std::string("none") : cfg.health_file);
 }

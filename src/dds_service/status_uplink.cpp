@@ -1,6 +1,7 @@
 #include "usv_fdi/dds_service/status_uplink.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -12,10 +13,28 @@ namespace {
 /// Same value: equal, or both NaN.
 bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
-/// |x - ref| relative to |ref| (at least `floor`); 0 when both are NaN.
+/// |x - ref| relative to |ref| (at least `floor`); 0 unless both are finite (a value that
+/// becomes or stops being finite is a discrete change).
 double relative(double x, double ref, double floor) {
-  if (std::isnan(x) || std::isnan(ref)) return 0.0;  // a NaN change is a discrete one
+  if (!std::isfinite(x) || !std::isfinite(ref)) return 0.0;
   return std::abs(x - ref) / std::max(std::abs(ref), floor);
+}
+
+/// A problem counter is news when it starts counting; its growth goes with the next heartbeat
+/// (a steady loss must not make every status urgent: its flag says it goes on).
+bool started(unsigned long long sent, unsigned long long now) { return sent == 0 && now > 0; }
+
+/// The message without its numbers ("12 samples lost" and "13 samples lost" say the same).
+std::string without_digits(const std::string& m) {
+  std::string out;
+  for (char c : m) {
+    if (std::isdigit(static_cast<unsigned char>(c)) == 0) {
+      out += c;
+    } else if (out.empty() || out.back() != '#') {
+      out += '#';
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -78,29 +97,43 @@ bool StatusUplink::discrete_change(const fdi::FdiStatus& a, const fdi::FdiStatus
   if (a.isolation_paused() != b.isolation_paused()) return changed("isolation_paused");
   if (a.incarnation() != b.incarnation()) return changed("incarnation");
   if (a.poles_v() != b.poles_v() || a.poles_g() != b.poles_g()) return changed("poles");
-  if (a.dropped() != b.dropped()) return changed("dropped");
-  if (a.rejected_timestamps() != b.rejected_timestamps()) return changed("rejected_timestamps");
-  if (a.invalid_values() != b.invalid_values()) return changed("invalid_values");
-  if (a.gaps() != b.gaps()) return changed("gaps");
-  if (a.reordered() != b.reordered()) return changed("reordered");
-  if (a.dropped_inputs() != b.dropped_inputs()) return changed("dropped_inputs");
-  if (a.lost_ins() != b.lost_ins() || a.lost_rudder() != b.lost_rudder()) return changed("lost");
-  if (a.acks_refused() != b.acks_refused() || a.acks_dropped() != b.acks_dropped()) {
+  if (started(a.dropped(), b.dropped())) return changed("dropped");
+  if (started(a.rejected_timestamps(), b.rejected_timestamps())) {
+    return changed("rejected_timestamps");
+  }
+  if (started(a.invalid_values(), b.invalid_values())) return changed("invalid_values");
+  if (started(a.gaps(), b.gaps())) return changed("gaps");
+  if (started(a.reordered(), b.reordered())) return changed("reordered");
+  if (started(a.dropped_inputs(), b.dropped_inputs())) return changed("dropped_inputs");
+  if (started(a.lost_ins(), b.lost_ins()) || started(a.lost_rudder(), b.lost_rudder())) {
+    return changed("lost");
+  }
+  if (started(a.acks_refused(), b.acks_refused()) || started(a.acks_dropped(), b.acks_dropped())) {
     return changed("acks");
   }
   if (a.other_event_writers() != b.other_event_writers()) return changed("other_event_writers");
+  // A counter that went back: a new run, or a counter reset; news.
+  if (b.dropped() < a.dropped() || b.rejected_timestamps() < a.rejected_timestamps() ||
+      b.invalid_values() < a.invalid_values() || b.gaps() < a.gaps() ||
+      b.reordered() < a.reordered() || b.dropped_inputs() < a.dropped_inputs() ||
+      b.lost_ins() < a.lost_ins() || b.lost_rudder() < a.lost_rudder() ||
+      b.acks_refused() < a.acks_refused() || b.acks_dropped() < a.acks_dropped()) {
+    return changed("a counter went back");
+  }
   if (!same(a.reference_speed(), b.reference_speed())) return changed("reference_speed");
-  // A value that appears or goes away (NaN) is news, not a deviation.
-  const auto nan_flip = [](double x, double y) { return std::isnan(x) != std::isnan(y); };
+  // A value that appears, goes away (NaN) or becomes infinite is news, not a deviation.
+  const auto flip = [](double x, double y) { return std::isfinite(x) != std::isfinite(y); };
   for (int i = 0; i < 4; ++i) {
-    if (nan_flip(a.a()[i], b.a()[i])) return changed("a");
+    if (flip(a.a()[i], b.a()[i])) return changed("a");
   }
-  if (nan_flip(a.excitation(), b.excitation()) || nan_flip(a.sigma_v(), b.sigma_v()) ||
-      nan_flip(a.sigma_r(), b.sigma_r()) || nan_flip(a.surge_speed(), b.surge_speed()) ||
-      nan_flip(a.speed_ratio(), b.speed_ratio())) {
-    return changed("a value became or stopped being NaN");
+  if (flip(a.excitation(), b.excitation()) || flip(a.sigma_v(), b.sigma_v()) ||
+      flip(a.sigma_r(), b.sigma_r()) || flip(a.surge_speed(), b.surge_speed()) ||
+      flip(a.speed_ratio(), b.speed_ratio())) {
+    return changed("a value became or stopped being finite");
   }
-  if (a.message() != b.message()) return changed("message");
+  if (without_digits(a.message().to_string()) != without_digits(b.message().to_string())) {
+    return changed("message");
+  }
   return false;
 }
 
@@ -109,7 +142,7 @@ double StatusUplink::deviation(const fdi::FdiStatus& s0, const fdi::FdiStatus& s
   double num = 0.0, den = 0.0;
   for (int i = 0; i < 4; ++i) {
     const double x = s.a()[i], x0 = s0.a()[i];
-    if (std::isnan(x) || std::isnan(x0)) continue;
+    if (!std::isfinite(x) || !std::isfinite(x0)) continue;
     num += (x - x0) * (x - x0);
     den += x0 * x0;
   }
@@ -137,19 +170,25 @@ UplinkReason StatusUplink::offer(const fdi::FdiStatus& s, double now) {
   } else {
     const double e = deviation(last_, s);
     e2 = e * e;
-    if (e2 > sigma2 + eta_ / o_.theta) {
+    // The heartbeat goes at the evaluation nearest its time: at most half an evaluation
+    // interval early, so that statuses are at most heartbeat + half an interval apart.
+    const double half_interval = have_offer_ ? 0.5 * std::max(0.0, now - last_offer_) : 0.0;
+    if (!(e2 <= sigma2 + eta_ / o_.theta)) {
       why = UplinkReason::kContinuous;
-    } else if (now - last_at_ >= o_.heartbeat) {
+    } else if (now - last_at_ + half_interval >= o_.heartbeat) {
       why = UplinkReason::kHeartbeat;
     }
   }
+  have_offer_ = true;
+  last_offer_ = now;
   if (why != UplinkReason::kNone) {
     last_ = s;
     last_at_ = now;
     have_ = true;
     e2 = 0.0;
   }
-  eta_ = std::max(0.0, o_.decay * eta_ + sigma2 - e2);
+  const double eta = o_.decay * eta_ + sigma2 - e2;
+  eta_ = eta > 0.0 ? eta : 0.0;  // also when e2 was not a number
   ++sent_[static_cast<int>(why)];
   return why;
 }

@@ -76,7 +76,8 @@ TEST(StatusUplink, EveryDiscreteChangeIsSentAtOnce) {
       {"lost", [](fdi::FdiStatus* s) { s->lost_ins(1); }},
       {"acks", [](fdi::FdiStatus* s) { s->acks_refused(1); }},
       {"message", [](fdi::FdiStatus* s) { s->message("model mismatch, not a sensor fault"); }},
-      {"a value became or stopped being NaN", [](fdi::FdiStatus* s) { s->surge_speed(NAN); }},
+      {"a value became or stopped being finite", [](fdi::FdiStatus* s) { s->surge_speed(NAN); }},
+      {"a value became or stopped being finite", [](fdi::FdiStatus* s) { s->sigma_v(INFINITY); }},
       {"incarnation", [](fdi::FdiStatus* s) { s->incarnation(2); }},
   };
   for (const Change& c : changes) {
@@ -92,7 +93,7 @@ TEST(StatusUplink, EveryDiscreteChangeIsSentAtOnce) {
 }
 
 TEST(StatusUplink, AMovingEstimateIsSentWhenItLeavesTheTolerance) {
-  StatusUplink u;  // tolerance 2 %
+  StatusUplink u;  // tolerance 8 %, bound 11.3 %
   fdi::FdiStatus s = healthy();
   u.offer(s, 0.0);
   // 1 % of A-hat: below the tolerance, and the budget a quiet status builds lets it stand.
@@ -100,13 +101,73 @@ TEST(StatusUplink, AMovingEstimateIsSentWhenItLeavesTheTolerance) {
   for (double& x : a) x *= 1.01;
   s.a(a);
   EXPECT_EQ(u.offer(s, 1.0), UplinkReason::kNone);
-  // 10 %: far past even the budget's bound, sent at once.
-  for (double& x : a) x *= 1.1;
+  // 15 %: past the bound, sent at once.
+  for (double& x : a) x *= 1.15;
   s.a(a);
   EXPECT_EQ(u.offer(s, 2.0), UplinkReason::kContinuous);
   // The surge speed: 1 m/s of 7 is news too.
   s.surge_speed(6.0);
   EXPECT_EQ(u.offer(s, 3.0), UplinkReason::kContinuous);
+}
+
+TEST(StatusUplink, TheHeartbeatGoesAtTheEvaluationNearestItsTime) {
+  // Evaluations about a second apart, a little early or late each time (the sidecar's wall
+  // clock): statuses are never more than heartbeat + half an interval apart.
+  StatusUplink u;  // heartbeat 3 s
+  const fdi::FdiStatus s = healthy();
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  double last = 0.0, longest = 0.0;
+  u.offer(s, 0.0);
+  for (int i = 1; i <= 600; ++i) {
+    const double now = i + jitter(rng);
+    if (u.offer(s, now) != UplinkReason::kNone) {
+      longest = std::max(longest, now - last);
+      last = now;
+    }
+  }
+  EXPECT_LE(longest, 3.0 + 0.5 * 1.1);
+  EXPECT_GE(u.sent_total(), 600u / 3);
+}
+
+TEST(StatusUplink, ASteadyLossIsSentWhenItStartsAndThenWithTheHeartbeat) {
+  // A link that loses samples every period: the counter and the count in the message grow
+  // every status, the period's flag stays set. Only the start is urgent.
+  StatusUplink u;
+  fdi::FdiStatus s = healthy();
+  ASSERT_EQ(u.offer(s, 0.0), UplinkReason::kFirst);
+  int urgent = 0, sent = 0;
+  for (int i = 1; i <= 30; ++i) {
+    s.lost_ins(5 * i);
+    s.input_flags(1u << 9);  // samples lost this period
+    s.message(("armed; " + std::to_string(5 * i) + " samples lost; ").c_str());
+    const UplinkReason r = u.offer(s, i);
+    if (r == UplinkReason::kDiscrete) ++urgent;
+    if (r != UplinkReason::kNone) ++sent;
+  }
+  EXPECT_EQ(urgent, 1);
+  EXPECT_EQ(sent, 10);
+  // When the losses stop, the flag clears: news.
+  s.input_flags(0);
+  EXPECT_EQ(u.offer(s, 31.0), UplinkReason::kDiscrete);
+  // A counter that goes back (a restart) is news too.
+  s.lost_ins(0);
+  EXPECT_EQ(u.offer(s, 32.0), UplinkReason::kDiscrete);
+}
+
+TEST(StatusUplink, AnInfiniteValueIsNewsBothWaysAndKeepsTheRuleWorking) {
+  StatusUplink u;
+  fdi::FdiStatus s = healthy();
+  u.offer(s, 0.0);
+  s.excitation(INFINITY);
+  EXPECT_EQ(u.offer(s, 1.0), UplinkReason::kDiscrete);
+  // While the copy holds an infinity, A-hat's moves are still seen.
+  auto a = s.a();
+  for (double& x : a) x *= 1.5;
+  s.a(a);
+  EXPECT_EQ(u.offer(s, 2.0), UplinkReason::kContinuous);
+  s.excitation(0.5);
+  EXPECT_EQ(u.offer(s, 3.0), UplinkReason::kDiscrete);
 }
 
 TEST(StatusUplink, TheShoreCopyStaysWithinTheBoundAndSendsFewerThanPeriodic) {

@@ -3,8 +3,10 @@
 // The pipeline makes a status every service.status_rate period. Periodic mode sends every one.
 // Event mode (the default) sends one when the shore's copy would no longer tell the truth:
 //  * at once, when anything discrete differs from the last one sent: convergence, arming,
-//    input health, flags, pause reasons, the message, any problem counter, the incarnation,
-//    the poles, the reference speed, a value becoming NaN or finite;
+//    input health, flags, pause reasons, the message (its numbers aside), the incarnation,
+//    the poles, the reference speed, a value becoming or ceasing to be finite, a problem counter
+//    that starts counting (its growth goes with the heartbeat: the period's input flags say
+//    that a problem goes on, so a steady loss does not make every status urgent);
 //  * when the continuous values (A-hat, excitation, the channels' sigma, the surge speed and
 //    speed ratio) have moved, relative to what was sent, past a dynamic event-triggering
 //    threshold (seed 002; Girard's dynamic triggering): with e the weighted relative deviation
@@ -13,9 +15,11 @@
 //        |e'|^2)
 //    (e' = 0 after a send). The budget a quiet period builds lets a brief excursion pass
 //    unsent, and |e| never exceeds sigma sqrt(1 + 1 / (theta (1 - lambda))) (bound());
-//  * at the first evaluation `heartbeat` s or more after the last one sent, so that a shore
-//    tells a live vessel from a silent one: statuses are at most heartbeat + one status period
-//    apart (the defaults, 3 s at 1 Hz: 3 s; keep that well under the shore's --silent-after, 5 s).
+//  * at the evaluation nearest `heartbeat` s after the last one sent, so that a shore tells a
+//    live vessel from a silent one: statuses are at most heartbeat + half a status period apart
+//    (3.5 s at the defaults, 3 s and 1 Hz; keep that well under the shore's --silent-after, 5 s).
+// The bound below holds at the evaluations, for the weighted sum of the relative deviations
+// (the excitation, at weight 0.2, may move five times as far), relative to the values sent.
 // Evaluations happen only at the status period: no two statuses closer than that (no Zeno
 // behaviour).
 #pragma once
@@ -78,6 +82,8 @@ class StatusUplink {
   bool have_ = false;
   fdi::FdiStatus last_;
   double last_at_ = 0.0;
+  bool have_offer_ = false;
+  double last_offer_ = 0.0;
   double eta_ = 0.0;
   std::uint64_t offered_ = 0;
   std::uint64_t sent_[6] = {0, 0, 0, 0, 0, 0};
