@@ -6,9 +6,11 @@
 //   usv_fdi_ros2_probe publish-paper --profiles FILE --domain N --participant-profile P
 //       [--speed S] [--rudder-sign K] [--imu /imu/data] [--twist /velocity]
 //       [--rudder /rudder_angle] [--odometry /odom] [--qos default|sensor_data]
-//       [--timeout SECONDS]
+//       [--timeout SECONDS] [--lead-in SECONDS]
 //     The paper's scenario (Otter, 50 Hz, noise-free; gyro bias on [20, 40) s, accelerometer
-//     bias on [60, 80) s) from the simulator, S times faster than real time (default 10), in
+//     bias on [60, 80) s; --lead-in L: L s of healthy voyage before it, the faults L s later,
+//     so that samples lost before the first fault leave the engine time to arm) from the
+//     simulator, S times faster than real time (default 10), in
 //     REP 103 signs: per sample std_msgs/Float64 rudder (K * δ, default K = 1), then
 //     sensor_msgs/Imu (angular_velocity.z = -r), then geometry_msgs/TwistStamped
 //     (twist.linear.y = -v), stamps t; with --odometry, nav_msgs/Odometry on that topic
@@ -72,7 +74,7 @@ struct DdsError : std::runtime_error {
 struct Options {
   std::string mode, profiles, participant_profile = "usv_fdi_participant_loopback";
   std::uint32_t domain = 0;
-  double speed = 10.0, timeout = 20.0;
+  double speed = 10.0, timeout = 20.0, lead_in = 0.0;
   int rudder_sign = 1;
   std::string imu = "rt/imu/data", twist = "rt/velocity", rudder = "rt/rudder_angle";
   std::string odometry;  ///< empty: TwistStamped on `twist`
@@ -99,6 +101,9 @@ Options parse(int argc, char** argv) {
       o.speed = std::stod(value);
     } else if (flag == "--timeout") {
       o.timeout = std::stod(value);
+    } else if (flag == "--lead-in") {
+      o.lead_in = std::stod(value);
+      if (!(o.lead_in >= 0.0)) throw UsageError("--lead-in: " + value + " (seconds, >= 0)");
     } else if (flag == "--rudder-sign") {
       o.rudder_sign = std::stoi(value);
     } else if (flag == "--imu") {
@@ -218,6 +223,11 @@ int publish_paper(const Options& o) {
   usvfdi::SimConfig cfg = usvfdi::paper_scenario(usvfdi::otter(), 50.0, 1);
   cfg.sigma_v = 0.0;  // noise-free, as `usv-fdi sim --noise-scale 0`
   cfg.sigma_r = 0.0;
+  cfg.duration += o.lead_in;
+  for (usvfdi::FaultInjection& f : cfg.faults) {
+    f.t_start += o.lead_in;
+    f.t_end += o.lead_in;
+  }
   usvfdi::Simulator sim(cfg);
   usvfdi::SimRow row;
   auto t0 = probe::Clock::now();
