@@ -185,10 +185,10 @@ bool parse_acks(const MonitorArgs& a, std::vector<AckRequest>* acks) {
   return true;
 }
 
-/// Joins the DDS domain with the fleet view's readers and reads the credentials' validity.
-/// Returns kExitOk, or the exit code after logging why not.
-int join_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
-                std::unique_ptr<FleetView>* view, CredentialExpiry* expiry) {
+}  // namespace
+
+int join_fleet_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
+                      std::unique_ptr<FleetView>* view, CredentialExpiry* expiry) {
   std::set<std::uint32_t> roster;
   std::string why;
   if (!a.roster.empty() && !load_roster(a.roster, &roster, &why)) {
@@ -223,6 +223,8 @@ int join_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
   }
   return kExitOk;
 }
+
+namespace {
 
 /// Receives until --expect instances are known, --once has the latched state, --duration
 /// (--once: kOnceDefaultDuration by default) has passed or a signal came, showing the table
@@ -322,7 +324,7 @@ int run_monitor(const MonitorArgs& a) {
   std::unique_ptr<dds::DdsContext> ctx;
   std::unique_ptr<FleetView> view;
   CredentialExpiry expiry;
-  int rc = join_domain(a, &ctx, &view, &expiry);
+  int rc = join_fleet_domain(a, &ctx, &view, &expiry);
   if (rc != kExitOk) return rc;
   const bool keep_watching = a.once || a.duration > 0.0 || a.expect > 0;
   if (!a.acks.empty()) {

@@ -6,7 +6,9 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 
+#include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
@@ -17,6 +19,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "credentials.hpp"
 #include "discovery_limit.hpp"
 #include "instance_owners.hpp"
 #include "latched_wait.hpp"
@@ -155,6 +158,7 @@ class FleetView {
       if (dec.verdict != OwnerDecision::Verdict::kShown) continue;
       changed = true;
       if (a_.json) emit_json(r);
+      if (on_row_) on_row_(r);
     }
     {
       fdi::FdiStatus st;
@@ -197,6 +201,9 @@ class FleetView {
     }
     return changed;
   }
+
+  /// Calls `f` with every fault event shown (after the ownership check), as it is applied.
+  void on_row(std::function<void(const Row&)> f) { on_row_ = std::move(f); }
 
   /// --once: true when the latched state has arrived (LatchedStateWait).
   bool latched_complete() const {
@@ -399,6 +406,13 @@ class FleetView {
   int discovery_limit_ = 0;   ///< unicast_discovery_limit() of the participant QoS (0: none)
   int discovery_warned_ = 0;  ///< discovery_limit_level() already warned about
   int conflicts_ = 0;
+  std::function<void(const Row&)> on_row_;
 };
+
+/// Joins the DDS domain with a fleet view's readers (the roster of a.roster) and reads the
+/// credentials' validity (monitor, dashboard). Returns kExitOk, or the exit code after logging
+/// why not.
+int join_fleet_domain(const MonitorArgs& a, std::unique_ptr<dds::DdsContext>* ctx,
+                      std::unique_ptr<FleetView>* view, CredentialExpiry* expiry);
 
 }  // namespace usvfdi::app

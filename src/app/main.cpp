@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   register_bridge_command(registry);
   register_emulate_command(registry);
   register_ros2_command(registry);
+  register_dashboard_command(registry);
 #endif
 
   try {

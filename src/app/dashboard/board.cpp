@@ -1,0 +1,185 @@
+#include "board.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "usv_fdi/pipeline/pipeline.hpp"
+
+namespace usvfdi::app::dashboard {
+namespace {
+
+using nlohmann::json;
+
+/// A number, or null when it is not finite (JSON has no NaN).
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+}  // namespace
+
+const char* presentation(FaultState s) {
+  switch (s) {
+    case FaultState::kRaised:
+      return "active-unacknowledged";
+    case FaultState::kActiveAcknowledged:
+      return "active-acknowledged";
+    case FaultState::kClearedUnacknowledged:
+      return "rectified-unacknowledged";
+    case FaultState::kNormal:
+    case FaultState::kAcknowledged:
+      break;
+  }
+  return "normal";
+}
+
+json row_json(const Row& r, double now) {
+  const FaultEvent& e = r.ev;
+  return json{{"mmsi", r.mmsi},
+              {"sensor", to_string(e.sensor)},
+              {"state", to_string(e.state)},
+              {"presentation", presentation(e.state)},
+              {"kind", to_string(e.kind)},
+              {"c_a", num(e.c_a)},
+              {"c_g", num(e.c_g)},
+              {"statistic", num(e.statistic)},
+              {"threshold", num(e.threshold)},
+              {"sequence", e.sequence},
+              {"incarnation", e.incarnation},
+              {"t", num(e.t)},
+              {"onset_time", num(e.onset_time)},
+              {"detection_time", num(e.detection_time)},
+              {"message", e.message},
+              {"written", num(r.written)},
+              {"age_s", num(now - r.written)},
+              {"alive", r.alive}};
+}
+
+json status_json(const VesselStatus& v) {
+  const fdi::FdiStatus& s = v.st;
+  return json{{"stamp", num(s.stamp())},
+              {"a", {num(s.a()[0]), num(s.a()[1]), num(s.a()[2]), num(s.a()[3])}},
+              {"converged", s.converged()},
+              {"armed", s.armed()},
+              {"excitation", num(s.excitation())},
+              {"sigma_v", num(s.sigma_v())},
+              {"sigma_r", num(s.sigma_r())},
+              {"ins_healthy", s.ins_healthy()},
+              {"rudder_healthy", s.rudder_healthy()},
+              {"input_flags", pipeline::input_flag_names(s.input_flags())},
+              {"identification_paused", pipeline::pause_reason_names(s.identification_paused())},
+              {"isolation_paused", pipeline::pause_reason_names(s.isolation_paused())},
+              {"samples", s.samples()},
+              {"dropped", s.dropped()},
+              {"message", s.message().to_string()},
+              {"surge_speed", num(s.surge_speed())},
+              {"speed_ratio", num(s.speed_ratio())},
+              {"written", num(v.written)},
+              {"alive", v.alive}};
+}
+
+void EventHistory::add(const Row& r) {
+  const RowKey key{r.mmsi, static_cast<int>(r.ev.sensor)};
+  const auto it = last_sequence_.find(key);
+  if (it != last_sequence_.end() && it->second == r.ev.sequence) return;
+  last_sequence_[key] = r.ev.sequence;
+  events_.push_front(r);
+  while (events_.size() > capacity_) events_.pop_back();
+}
+
+/// Checks an acknowledgement request's body; false and *why (naming what is wrong) if bad.
+bool parse_ack_body(const std::string& body, AckWork* out, std::string* why) {
+  json j;
+  try {
+    j = json::parse(body);
+  } catch (const json::parse_error& e) {
+    *why = std::string("the body is not JSON: ") + e.what();
+    return false;
+  }
+  if (!j.is_object()) {
+    *why = "the body must be a JSON object {mmsi, sensor, sequence, operator}";
+    return false;
+  }
+  const auto field = [&](const char* name) -> const json* {
+    const auto it = j.find(name);
+    return it == j.end() ? nullptr : &*it;
+  };
+  const json* m = field("mmsi");
+  if (m == nullptr || !m->is_number_unsigned() || m->get<std::uint64_t>() == 0 ||
+      m->get<std::uint64_t>() > 999999999u) {
+    *why = "mmsi: an integer 1..999999999 is required";
+    return false;
+  }
+  const json* s = field("sensor");
+  if (s == nullptr || !s->is_string() || !parse_sensor(s->get<std::string>(), &out->req.sensor)) {
+    *why = "sensor: accelerometer, gyro or unknown is required";
+    return false;
+  }
+  const json* q = field("sequence");
+  if (q == nullptr || !q->is_number_unsigned() || q->get<std::uint64_t>() == 0) {
+    *why = "sequence: an integer >= 1 is required (the event's sequence shown on the board)";
+    return false;
+  }
+  const json* o = field("operator");
+  if (o == nullptr || !o->is_string() || o->get<std::string>().empty() ||
+      o->get<std::string>().size() > 63) {
+    *why = "operator: the operator's name (1 to 63 characters) is required";
+    return false;
+  }
+  for (const char c : o->get<std::string>()) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      *why = "operator: control characters are not allowed";
+      return false;
+    }
+  }
+  out->req.mmsi = static_cast<std::uint32_t>(m->get<std::uint64_t>());
+  out->req.sequence = q->get<std::uint64_t>();
+  out->operator_id = o->get<std::string>();
+  return true;
+}
+
+json EventHistory::to_json(double now) const {
+  json out = json::array();
+  for (const Row& r : events_) out.push_back(row_json(r, now));
+  return out;
+}
+
+json board_json(const BoardInput& in, const EventHistory& events,
+                const std::deque<AckOutcome>& acks, double now) {
+  std::set<std::uint32_t> mmsis;
+  for (const auto& [key, row] : in.rows) mmsis.insert(key.first);
+  for (const auto& [m, st] : in.statuses) mmsis.insert(m);
+  for (const auto& [m, age] : in.heard_age) mmsis.insert(m);
+  for (const std::uint32_t m : in.roster_never_heard) mmsis.insert(m);
+  json vessels = json::array();
+  for (const std::uint32_t m : mmsis) {
+    json v{{"mmsi", m}};
+    json sensors = json::object();
+    for (const auto& [key, row] : in.rows) {
+      if (key.first == m) sensors[to_string(row.ev.sensor)] = row_json(row, now);
+    }
+    v["sensors"] = sensors;
+    const auto st = in.statuses.find(m);
+    v["status"] = st == in.statuses.end() ? json(nullptr) : status_json(st->second);
+    const auto age = in.heard_age.find(m);
+    v["heard_age_s"] = age == in.heard_age.end() ? json(nullptr) : num(age->second);
+    const auto sil = in.silent.find(m);
+    v["silent"] = sil != in.silent.end() && sil->second;
+    bool never = false;
+    for (const std::uint32_t r : in.roster_never_heard) never = never || r == m;
+    v["never_heard"] = never;
+    vessels.push_back(v);
+  }
+  json ack_list = json::array();
+  for (const AckOutcome& a : acks) {
+    ack_list.push_back(json{{"mmsi", a.mmsi},
+                            {"sensor", to_string(a.sensor)},
+                            {"sequence", a.sequence},
+                            {"operator", a.operator_id},
+                            {"sent", num(a.sent)},
+                            {"state", a.state},
+                            {"reason", a.reason}});
+  }
+  return json{
+      {"now", num(now)},    {"silent_after", num(in.silent_after)}, {"conflicts", in.conflicts},
+      {"vessels", vessels}, {"events", events.to_json(now)},        {"acks", ack_list}};
+}
+
+}  // namespace usvfdi::app::dashboard

@@ -1,0 +1,82 @@
+// The dashboard's picture of the fleet, as JSON for the browser: the fleet board (one entry per
+// vessel, each sensor's latched state in the IEC 62923 presentation), the event list (newest
+// first) and the acknowledgements the dashboard sent. Pure functions of the monitor's model
+// (Row, VesselStatus, VesselLiveness): no DDS, no HTTP.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "../ack_protocol.hpp"
+#include "../monitor_model.hpp"
+#include "../vessel_liveness.hpp"
+
+namespace usvfdi::app::dashboard {
+
+/// IEC 62923-1 alert state of a latched instance: active-unacknowledged (raised),
+/// active-acknowledged, rectified-unacknowledged (cleared, not acknowledged), normal.
+const char* presentation(FaultState s);
+
+/// One fault instance as the browser shows it. `now`: wall clock [s since epoch].
+nlohmann::json row_json(const Row& r, double now);
+/// One vessel's detector status (FdiStatus) as the browser shows it.
+nlohmann::json status_json(const VesselStatus& v);
+
+/// Every event the dashboard received (each FaultEvent shown), newest first, at most `capacity`.
+class EventHistory {
+ public:
+  explicit EventHistory(std::size_t capacity = 1000) : capacity_(capacity) {}
+  /// Records an event unless the same (vessel, sensor, sequence) was recorded last for that
+  /// instance (a late joiner's copy of the latched state, or a writer's repeat).
+  void add(const Row& r);
+  nlohmann::json to_json(double now) const;
+  std::size_t size() const { return events_.size(); }
+
+ private:
+  std::size_t capacity_;
+  std::deque<Row> events_;
+  std::map<RowKey, std::uint64_t> last_sequence_;
+};
+
+/// An acknowledgement asked for by a browser.
+struct AckWork {
+  AckRequest req;
+  std::string operator_id;
+};
+
+/// Checks a POST /api/ack body {mmsi, sensor, sequence, operator}; false and *why (naming the
+/// field that is wrong) if it is not one.
+bool parse_ack_body(const std::string& body, AckWork* out, std::string* why);
+
+/// What became of an acknowledgement sent from the dashboard.
+struct AckOutcome {
+  std::uint32_t mmsi = 0;
+  Sensor sensor = Sensor::kUnknown;
+  std::uint64_t sequence = 0;
+  std::string operator_id;
+  double sent = 0.0;   ///< wall clock [s since epoch]
+  std::string state;   ///< "pending", "accepted" or "refused"
+  std::string reason;  ///< why it was refused ("" otherwise)
+};
+
+/// The whole board: vessels (those heard, those with a latched instance and those of the
+/// roster), each with its sensors' rows, status and liveness; the events; the acknowledgements.
+struct BoardInput {
+  std::map<RowKey, Row> rows;
+  std::map<std::uint32_t, VesselStatus> statuses;
+  std::map<std::uint32_t, double> heard_age;  ///< seconds since last heard
+  std::map<std::uint32_t, bool> silent;
+  std::vector<std::uint32_t> roster_never_heard;
+  double silent_after = 5.0;
+  int conflicts = 0;
+};
+nlohmann::json board_json(const BoardInput& in, const EventHistory& events,
+                          const std::deque<AckOutcome>& acks, double now);
+
+}  // namespace usvfdi::app::dashboard

@@ -1,0 +1,165 @@
+// usv-fdi dashboard: renders the fleet board the dashboard pushes (server-sent events on
+// /api/stream, the whole board on every change and once a second for the ages) and posts
+// acknowledgements to /api/ack. No framework, no network beyond the dashboard itself.
+'use strict';
+
+const SENSORS = ['accelerometer', 'gyro', 'unknown'];
+const STATE_WORDS = {
+  'active-unacknowledged': 'ACTIVE, not acknowledged',
+  'active-acknowledged': 'active, acknowledged',
+  'rectified-unacknowledged': 'rectified, not acknowledged',
+  'normal': 'normal',
+};
+let board = null;
+
+function el(tag, attrs, ...children) {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs || {})) {
+    if (k === 'class') e.className = v; else if (k.startsWith('data-')) e.setAttribute(k, v);
+    else e[k] = v;
+  }
+  for (const c of children) e.append(c instanceof Node ? c : document.createTextNode(String(c)));
+  return e;
+}
+
+function fixed(x, n) { return x === null || x === undefined ? '–' : Number(x).toFixed(n); }
+function age(s) {
+  if (s === null || s === undefined) return '–';
+  if (s < 60) return s.toFixed(1) + ' s';
+  if (s < 3600) return Math.floor(s / 60) + ' min ' + Math.floor(s % 60) + ' s';
+  return Math.floor(s / 3600) + ' h ' + Math.floor((s % 3600) / 60) + ' min';
+}
+function utc(t) { return t === null ? '–' : new Date(t * 1000).toISOString().replace('T', ' ').slice(0, 23); }
+
+function sensorCell(v, sensor) {
+  const r = v.sensors[sensor];
+  const td = el('td', { 'data-mmsi': v.mmsi, 'data-sensor': sensor });
+  if (!r) {
+    td.append(el('div', { class: 'cell alert-normal', 'data-presentation': 'normal' }, 'normal'));
+    return td;
+  }
+  const cell = el('div', {
+    class: 'cell alert-' + r.presentation,
+    'data-presentation': r.presentation,
+    'data-state': r.state,
+    'data-sequence': r.sequence,
+    'data-written': r.written,
+  });
+  cell.append(el('div', { class: 'state' }, STATE_WORDS[r.presentation] || r.presentation));
+  cell.append(el('div', { class: 'detail' },
+    `${r.kind} · C_a ${fixed(r.c_a, 2)} · C_g ${fixed(r.c_g, 2)} · #${r.sequence} · ${age(r.age_s)} ago`));
+  if (!r.alive) cell.append(el('div', { class: 'detail' }, 'sidecar gone: last known state'));
+  const ackable = r.state === 'raised' || r.state === 'cleared';
+  if (ackable && board.can_ack) {
+    const b = el('button', { class: 'ack', 'data-mmsi': v.mmsi, 'data-sensor': sensor,
+                             'data-sequence': r.sequence }, 'Acknowledge #' + r.sequence);
+    b.addEventListener('click', () => acknowledge(v.mmsi, sensor, r.sequence));
+    cell.append(b);
+  }
+  td.append(cell);
+  return td;
+}
+
+function detector(s) {
+  if (!s) return 'no status yet';
+  const parts = [s.converged ? 'converged' : 'not converged', s.armed ? 'armed' : 'not armed'];
+  if (!s.ins_healthy) parts.push('INS unhealthy');
+  if (!s.rudder_healthy) parts.push('rudder unhealthy');
+  if (s.input_flags) parts.push(s.input_flags);
+  if (s.isolation_paused) parts.push('isolation paused: ' + s.isolation_paused);
+  return parts.join(' · ');
+}
+
+function renderBoard() {
+  const body = document.querySelector('#board tbody');
+  body.replaceChildren();
+  for (const v of board.vessels) {
+    const tr = el('tr', { 'data-mmsi': v.mmsi, class: v.silent || v.never_heard ? 'silent' : '' });
+    tr.append(el('td', { class: 'vessel' }, v.mmsi));
+    const heard = v.never_heard ? 'never heard' :
+      (v.silent ? 'SILENT ' : '') + age(v.heard_age_s) + ' ago';
+    tr.append(el('td', { class: 'heard', 'data-silent': v.silent }, heard));
+    tr.append(el('td', { class: 'detector' }, detector(v.status)));
+    for (const s of SENSORS) tr.append(sensorCell(v, s));
+    body.append(tr);
+  }
+  const active = board.vessels.reduce((n, v) => n + SENSORS.filter(
+    (s) => v.sensors[s] && v.sensors[s].presentation === 'active-unacknowledged').length, 0);
+  const silent = board.vessels.filter((v) => v.silent).length;
+  document.getElementById('summary').textContent =
+    `${board.vessels.length} vessel(s) · ${active} unacknowledged active alert(s) · ${silent} silent`;
+}
+
+function renderEvents() {
+  const fv = document.getElementById('f-vessel');
+  const known = new Set([...fv.options].map((o) => o.value));
+  for (const v of board.vessels) {
+    if (!known.has(String(v.mmsi))) fv.append(el('option', { value: v.mmsi }, v.mmsi));
+  }
+  const want = { mmsi: fv.value, sensor: document.getElementById('f-sensor').value,
+                 state: document.getElementById('f-state').value };
+  const body = document.querySelector('#events tbody');
+  body.replaceChildren();
+  for (const e of board.events) {
+    if (want.mmsi && String(e.mmsi) !== want.mmsi) continue;
+    if (want.sensor && e.sensor !== want.sensor) continue;
+    if (want.state && e.state !== want.state) continue;
+    body.append(el('tr', { 'data-mmsi': e.mmsi, 'data-sensor': e.sensor, 'data-state': e.state,
+                           'data-sequence': e.sequence },
+      el('td', {}, utc(e.written)), el('td', {}, e.mmsi), el('td', {}, e.sensor),
+      el('td', {}, e.state), el('td', {}, e.kind), el('td', {}, fixed(e.c_a, 2)),
+      el('td', {}, fixed(e.c_g, 2)), el('td', {}, e.sequence), el('td', {}, e.message)));
+  }
+}
+
+function renderAcks() {
+  const body = document.querySelector('#acks tbody');
+  body.replaceChildren();
+  for (const a of board.acks) {
+    const outcome = a.state === 'refused' ? 'refused: ' + a.reason : a.state;
+    body.append(el('tr', { 'data-mmsi': a.mmsi, 'data-sensor': a.sensor, 'data-state': a.state },
+      el('td', {}, utc(a.sent)), el('td', {}, a.operator), el('td', {}, a.mmsi),
+      el('td', {}, a.sensor), el('td', {}, a.sequence),
+      el('td', { class: a.state }, outcome)));
+  }
+}
+
+function render() {
+  document.getElementById('operator-box').hidden = !board.can_ack;
+  renderBoard();
+  renderEvents();
+  renderAcks();
+}
+
+async function acknowledge(mmsi, sensor, sequence) {
+  const out = document.getElementById('ack-result');
+  const operator = document.getElementById('operator').value.trim();
+  if (!operator) {
+    out.textContent = 'Give your name (Operator) before acknowledging.';
+    out.className = 'refused';
+    return;
+  }
+  localStorage.setItem('usv-fdi-operator', operator);
+  const r = await fetch('/api/ack', {
+    method: 'POST', headers: { 'Content-Type': 'application/json' },
+    body: JSON.stringify({ mmsi, sensor, sequence, operator }),
+  });
+  const reply = await r.json().catch(() => ({ error: r.statusText }));
+  out.textContent = r.ok ? `Acknowledgement of ${mmsi} ${sensor} #${sequence} sent.`
+                         : `Not sent: ${reply.error}`;
+  out.className = r.ok ? 'accepted' : 'refused';
+}
+
+function connect() {
+  const link = document.getElementById('link');
+  const es = new EventSource('/api/stream');
+  es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
+  es.onmessage = (m) => { board = JSON.parse(m.data); render(); };
+  es.onerror = () => { link.textContent = 'reconnecting'; link.className = 'link down'; };
+}
+
+for (const id of ['f-vessel', 'f-sensor', 'f-state']) {
+  document.getElementById(id).addEventListener('change', () => board && renderEvents());
+}
+document.getElementById('operator').value = localStorage.getItem('usv-fdi-operator') || '';
+connect();

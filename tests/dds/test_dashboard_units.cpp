@@ -1,0 +1,120 @@
+// Units of usv-fdi dashboard with no DDS and no HTTP in them (src/app/dashboard/board.cpp): the
+// IEC 62923 presentation, the event history, the board's JSON and the acknowledgement request's
+// checks. The page itself is tested in a real browser (tests/dashboard).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "dashboard/board.hpp"
+
+namespace usvfdi::app::dashboard {
+namespace {
+
+Row row(std::uint32_t mmsi, Sensor s, FaultState st, std::uint64_t seq, double written = 100.0) {
+  Row r;
+  r.mmsi = mmsi;
+  r.ev.sensor = s;
+  r.ev.state = st;
+  r.ev.kind = FaultKind::kBias;
+  r.ev.sequence = seq;
+  r.ev.c_a = 0.1;
+  r.ev.c_g = 0.9;
+  r.written = written;
+  return r;
+}
+
+TEST(DashboardBoard, EveryLatchedStateHasItsIec62923Presentation) {
+  EXPECT_STREQ(presentation(FaultState::kRaised), "active-unacknowledged");
+  EXPECT_STREQ(presentation(FaultState::kActiveAcknowledged), "active-acknowledged");
+  EXPECT_STREQ(presentation(FaultState::kClearedUnacknowledged), "rectified-unacknowledged");
+  EXPECT_STREQ(presentation(FaultState::kAcknowledged), "normal");
+  EXPECT_STREQ(presentation(FaultState::kNormal), "normal");
+}
+
+TEST(DashboardBoard, TheHistoryIsNewestFirstBoundedAndSkipsRepeats) {
+  EventHistory h(3);
+  h.add(row(1, Sensor::kGyro, FaultState::kRaised, 1));
+  h.add(row(1, Sensor::kGyro, FaultState::kRaised, 1));  // a late joiner's copy: not again
+  h.add(row(1, Sensor::kGyro, FaultState::kClearedUnacknowledged, 2));
+  h.add(row(2, Sensor::kAccelerometer, FaultState::kRaised, 1));
+  EXPECT_EQ(h.size(), 3u);
+  h.add(row(1, Sensor::kGyro, FaultState::kAcknowledged, 3));
+  ASSERT_EQ(h.size(), 3u);  // the oldest went
+  const auto j = h.to_json(200.0);
+  EXPECT_EQ(j[0]["sequence"], 3);
+  EXPECT_EQ(j[1]["mmsi"], 2);
+  EXPECT_EQ(j[2]["sequence"], 2);
+  EXPECT_DOUBLE_EQ(j[0]["age_s"].get<double>(), 100.0);
+}
+
+TEST(DashboardBoard, TheBoardHasEveryVesselHeardLatchedOrOnTheRoster) {
+  BoardInput in;
+  in.rows[{7, static_cast<int>(Sensor::kGyro)}] = row(7, Sensor::kGyro, FaultState::kRaised, 1);
+  in.heard_age[7] = 0.5;
+  in.silent[7] = false;
+  in.heard_age[8] = 9.0;  // heard, silent, nothing latched
+  in.silent[8] = true;
+  in.roster_never_heard = {9};
+  Row nan = row(7, Sensor::kAccelerometer, FaultState::kClearedUnacknowledged, 2);
+  nan.ev.c_a = std::numeric_limits<double>::quiet_NaN();
+  in.rows[{7, static_cast<int>(Sensor::kAccelerometer)}] = nan;
+  EventHistory h;
+  std::deque<AckOutcome> acks(1);
+  acks[0].mmsi = 7;
+  acks[0].sensor = Sensor::kGyro;
+  acks[0].sequence = 1;
+  acks[0].operator_id = "alice";
+  acks[0].state = "refused";
+  acks[0].reason = "stale sequence";
+  const auto j = board_json(in, h, acks, 101.0);
+  ASSERT_EQ(j["vessels"].size(), 3u);
+  const auto& v7 = j["vessels"][0];
+  EXPECT_EQ(v7["mmsi"], 7);
+  EXPECT_EQ(v7["sensors"]["gyro"]["presentation"], "active-unacknowledged");
+  EXPECT_EQ(v7["sensors"]["gyro"]["state"], "raised");
+  EXPECT_TRUE(v7["sensors"]["accelerometer"]["c_a"].is_null()) << "NaN is null, not invalid JSON";
+  EXPECT_TRUE(v7["status"].is_null());
+  EXPECT_FALSE(v7["silent"].get<bool>());
+  EXPECT_TRUE(j["vessels"][1]["silent"].get<bool>());
+  EXPECT_TRUE(j["vessels"][2]["never_heard"].get<bool>());
+  EXPECT_TRUE(j["vessels"][2]["heard_age_s"].is_null());
+  EXPECT_EQ(j["acks"][0]["reason"], "stale sequence");
+  EXPECT_NO_THROW(nlohmann::json::parse(j.dump()));
+}
+
+TEST(DashboardBoard, AnAckRequestIsCheckedFieldByField) {
+  AckWork w;
+  std::string why;
+  ASSERT_TRUE(parse_ack_body(R"({"mmsi":257000001,"sensor":"gyro","sequence":3,"operator":"al"})",
+                             &w, &why))
+      << why;
+  EXPECT_EQ(w.req.mmsi, 257000001u);
+  EXPECT_EQ(w.req.sensor, Sensor::kGyro);
+  EXPECT_EQ(w.req.sequence, 3u);
+  EXPECT_EQ(w.operator_id, "al");
+  const auto refused = [&](const std::string& body, const std::string& named) {
+    AckWork x;
+    std::string y;
+    EXPECT_FALSE(parse_ack_body(body, &x, &y)) << body;
+    EXPECT_NE(y.find(named), std::string::npos) << body << " -> " << y;
+  };
+  refused("not json", "not JSON");
+  refused("[1,2]", "object");
+  refused(R"({"sensor":"gyro","sequence":3,"operator":"a"})", "mmsi");
+  refused(R"({"mmsi":0,"sensor":"gyro","sequence":3,"operator":"a"})", "mmsi");
+  refused(R"({"mmsi":1000000000,"sensor":"gyro","sequence":3,"operator":"a"})", "mmsi");
+  refused(R"({"mmsi":-5,"sensor":"gyro","sequence":3,"operator":"a"})", "mmsi");
+  refused(R"({"mmsi":"257","sensor":"gyro","sequence":3,"operator":"a"})", "mmsi");
+  refused(R"({"mmsi":1,"sensor":"compass","sequence":3,"operator":"a"})", "sensor");
+  refused(R"({"mmsi":1,"sensor":"gyro","sequence":0,"operator":"a"})", "sequence");
+  refused(R"({"mmsi":1,"sensor":"gyro","sequence":2.5,"operator":"a"})", "sequence");
+  refused(R"({"mmsi":1,"sensor":"gyro","sequence":3})", "operator");
+  refused(R"({"mmsi":1,"sensor":"gyro","sequence":3,"operator":""})", "operator");
+  refused(R"({"mmsi":1,"sensor":"gyro","sequence":3,"operator":")" + std::string(64, 'x') + R"("})",
+          "operator");
+  refused(R"({"mmsi":1,"sensor":"gyro","sequence":3,"operator":"a\nb"})", "control");
+}
+
+}  // namespace
+}  // namespace usvfdi::app::dashboard
