@@ -38,11 +38,15 @@ mapfile -t pkgs < <(awk -v want=" ${only[*]:-} " '
   (want == "  " || index(want, " " section " ")) && !seen[$0]++ { print }
 ' "$list")
 if [ "$print_only" -eq 1 ]; then
-  printf '%s\n' "${pkgs[@]}"
+  printf '%s\n' "${pkgs[@]%%|*}"
   exit 0
 fi
+# A line PACKAGE|COMMAND installs PACKAGE only when COMMAND is not on the PATH (Node.js and npm:
+# a machine may have them from elsewhere, and Debian's npm would conflict with that nodejs).
 missing=()
-for p in "${pkgs[@]}"; do
+for entry in "${pkgs[@]}"; do
+  p="${entry%%|*}"
+  if [ "$p" != "$entry" ] && command -v "${entry#*|}" >/dev/null 2>&1; then continue; fi
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
     missing+=("$p")
   fi

@@ -1,0 +1,207 @@
+// Browser tests of `usv-fdi dashboard`: Debian's headless Chromium driven by playwright-core,
+// against the real sidecar, simulator and fleet emulator on loopback (separate processes, real
+// Fast DDS participants, a partition of their own).
+//
+// Environment (set by ctest, tests/dashboard/CMakeLists.txt): USV_FDI_EXE, USV_FDI_QOS,
+// USV_FDI_PAPER_CONFIG, USV_FDI_DOMAIN, CHROMIUM (default /usr/bin/chromium), OUT_DIR (logs and
+// screenshots).
+import { test, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import path from 'node:path';
+import { chromium } from 'playwright-core';
+
+const exe = process.env.USV_FDI_EXE;
+const qos = process.env.USV_FDI_QOS;
+const paper = process.env.USV_FDI_PAPER_CONFIG;
+const domain = process.env.USV_FDI_DOMAIN || String(150 + (process.pid % 40));
+const out = process.env.OUT_DIR || fs.mkdtempSync('/tmp/usv_fdi_dashboard_');
+fs.mkdirSync(out, { recursive: true });
+for (const [k, v] of Object.entries({ USV_FDI_EXE: exe, USV_FDI_QOS: qos, USV_FDI_PAPER_CONFIG: paper })) {
+  if (!v || !fs.existsSync(v)) throw new Error(`${k} must name an existing file (got '${v}')`);
+}
+
+const children = [];
+function start(name, args) {
+  const log = path.join(out, name + '.log');
+  const fd = fs.openSync(log, 'w');
+  const p = spawn(exe, args, { stdio: ['ignore', fd, fd] });
+  fs.closeSync(fd);
+  const child = { name, p, log, exited: new Promise((r) => p.on('exit', (code) => r(code))) };
+  children.push(child);
+  return child;
+}
+const readLog = (c) => fs.readFileSync(c.log, 'utf8');
+async function waitFor(what, fn, seconds) {
+  const end = Date.now() + seconds * 1000;
+  for (;;) {
+    const v = await fn();
+    if (v) return v;
+    if (Date.now() > end) throw new Error(`${what}: not within ${seconds} s`);
+    await new Promise((r) => setTimeout(r, 50));
+  }
+}
+const waitLog = (c, text, s = 30) =>
+  waitFor(`'${text}' in ${c.name}.log:\n${readLog(c)}`, () => readLog(c).includes(text), s);
+async function stop(c) {
+  if (c.p.exitCode === null) c.p.kill('SIGTERM');
+  const t = setTimeout(() => c.p.kill('SIGKILL'), 10000);
+  const code = await c.exited;
+  clearTimeout(t);
+  return code;
+}
+let browser = null;
+after(async () => {
+  if (browser) await browser.close();
+  for (const c of children) await stop(c);
+});
+async function launch() {
+  if (browser) return browser;
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+           '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+  return browser;
+}
+async function newPage() {
+  const ctx = await (await launch()).newContext({ viewport: { width: 1400, height: 900 } });
+  const page = await ctx.newPage();
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  // (the refusals the tests provoke on purpose, 400 and 403, are logged by the browser too)
+  page.on('console', (m) => {
+    if (m.type() === 'error' && !/status of 40[03]/.test(m.text())) errors.push(m.text());
+  });
+  page.errors = errors;
+  return page;
+}
+
+function dds(partition) {
+  return ['--domain', domain, '--qos', qos, '--participant-profile',
+          'usv_fdi_participant_loopback', '--partition', partition];
+}
+async function dashboard(name, partition, extra = []) {
+  const d = start(name, ['dashboard', ...dds(partition), '--listen', '127.0.0.1:0', ...extra]);
+  await waitLog(d, ': running', 30);
+  const m = readLog(d).match(/dashboard on (http:\/\/127\.0\.0\.1:\d+\/)/);
+  assert.ok(m, readLog(d));
+  d.url = m[1];
+  return d;
+}
+const cell = (mmsi, sensor) => `td[data-mmsi="${mmsi}"][data-sensor="${sensor}"] .cell`;
+
+test('a sidecar\'s faults on the board: raise, late browser, acknowledge, observer', async () => {
+  const mmsi = 257000071;
+  const part = `usv_fdi_dash_${process.pid}_a`;
+  const svc = start('sidecar', ['run', '--config', paper, '--mmsi', String(mmsi), '--reliable-inputs',
+                                ...dds(part)]);
+  await waitLog(svc, 'waiting for INS and rudder');
+  const dash = await dashboard('dashboard', part);
+  const page = await newPage();
+  await page.goto(dash.url);
+  // Once the sidecar's status is heard, its vessel has a row, every sensor normal.
+  await page.waitForSelector(`tr[data-mmsi="${mmsi}"]`, { timeout: 30000 });
+  assert.equal(await page.textContent('#link'), 'live');
+
+  // WHEN the simulator publishes the paper's scenario (gyro bias 20-40 s, accelerometer 60-80 s)
+  const sim = start('sim', ['sim', '--publish', '--mmsi', String(mmsi), '--vessel', 'otter',
+                            '--scenario', 'paper', '--noise-scale', '0', '--speed', '4',
+                            '--reliable', '--linger', '0.5', ...dds(part)]);
+  // THEN the gyro's raise shows, flashing, soon after the sidecar wrote it
+  const raised = `${cell(mmsi, 'gyro')}[data-state="raised"][data-sequence="1"]`;
+  await page.waitForSelector(raised, { timeout: 90000 });
+  const shownAt = Date.now() / 1000;
+  const written = Number(await page.getAttribute(raised, 'data-written'));
+  const latency = shownAt - written;
+  console.log(`raise shown ${latency.toFixed(3)} s after the sidecar wrote it`);
+  fs.writeFileSync(path.join(out, 'raise_latency.txt'), `${latency}\n`);
+  assert.ok(latency >= -0.05 && latency < 3.0, `raise shown after ${latency} s`);
+  assert.equal(await page.getAttribute(raised, 'data-presentation'), 'active-unacknowledged');
+  const anim = await page.$eval(raised, (e) => getComputedStyle(e).animationName);
+  assert.equal(anim, 'flash', 'active-unacknowledged flashes');
+  assert.match(await page.textContent(`${cell(mmsi, 'gyro')} .detail`), /C_g 1\.00/);
+  // and the accelerometer's, then both clear
+  await page.waitForSelector(`${cell(mmsi, 'accelerometer')}[data-state="raised"]`, { timeout: 90000 });
+  assert.equal(await sim.exited, 0, readLog(sim));
+  await page.waitForSelector(`${cell(mmsi, 'accelerometer')}[data-sequence="2"]`, { timeout: 30000 });
+  await page.screenshot({ path: path.join(out, 'board.png'), fullPage: true });
+  // The event list has every event, newest first, and filters by sensor.
+  const seqs = await page.$$eval('#events tbody tr', (rows) => rows.map((r) => r.dataset.sensor + r.dataset.sequence));
+  assert.ok(seqs.indexOf('gyro1') > seqs.indexOf('gyro2') && seqs.indexOf('gyro2') > seqs.indexOf('accelerometer1'), seqs.join());
+  await page.selectOption('#f-sensor', 'gyro');
+  const shown = await page.$$eval('#events tbody tr', (rows) => rows.map((r) => r.dataset.sensor));
+  assert.ok(shown.length >= 2 && shown.every((s) => s === 'gyro'), shown.join());
+
+  // WHEN a browser connects late, THEN it shows the latched state at once
+  const late = await newPage();
+  const t0 = Date.now();
+  await late.goto(dash.url);
+  const gyroState = await page.getAttribute(cell(mmsi, 'gyro'), 'data-state');
+  await late.waitForSelector(`${cell(mmsi, 'gyro')}[data-state="${gyroState}"]`, { timeout: 5000 });
+  console.log(`late browser had the latched state after ${(Date.now() - t0) / 1000} s`);
+
+  // WHEN the operator acknowledges the gyro's event with the button
+  const seq = await page.getAttribute(cell(mmsi, 'gyro'), 'data-sequence');
+  await page.fill('#operator', 'alice');
+  await page.click(`button.ack[data-mmsi="${mmsi}"][data-sensor="gyro"]`);
+  // THEN the sidecar accepts it (logged with the operator) and the board moves on
+  await page.waitForSelector(`#acks tbody tr[data-sensor="gyro"][data-state="accepted"]`, { timeout: 30000 });
+  await page.waitForSelector(`${cell(mmsi, 'gyro')}[data-sequence="${Number(seq) + 1}"]`, { timeout: 10000 });
+  assert.notEqual(await page.getAttribute(cell(mmsi, 'gyro'), 'data-presentation'), 'active-unacknowledged');
+  await waitLog(svc, 'by alice accepted', 10);
+  assert.match(readLog(svc), new RegExp(`gyro #${Number(seq) + 1} \\w+ .*acknowledged by alice`));
+
+  // WHEN an observer's dashboard (--read-only) shows the same fleet
+  const obs = await dashboard('observer', part, ['--read-only']);
+  const op = await newPage();
+  await op.goto(obs.url);
+  await op.waitForSelector(`${cell(mmsi, 'accelerometer')}[data-state]`, { timeout: 30000 });
+  // THEN it has no acknowledge button, and a forged request is refused
+  assert.equal(await op.$$eval('button.ack', (b) => b.length), 0);
+  assert.equal(await op.isVisible('#operator'), false);
+  const forged = await op.evaluate(async ([m]) => {
+    const r = await fetch('/api/ack', { method: 'POST', body: JSON.stringify(
+      { mmsi: m, sensor: 'accelerometer', sequence: 2, operator: 'mallory' }) });
+    return [r.status, (await r.json()).error];
+  }, [mmsi]);
+  assert.equal(forged[0], 403);
+  assert.match(forged[1], /read-only/);
+  await new Promise((r) => setTimeout(r, 1000));
+  assert.ok(!readLog(svc).includes('mallory'), 'the sidecar never saw the forged ack');
+  // A malformed request to the operator's dashboard is refused with what was wrong.
+  const bad = await page.evaluate(async () => {
+    const r = await fetch('/api/ack', { method: 'POST', body: '{"mmsi": 1, "sensor": "gyroscope"}' });
+    return [r.status, (await r.json()).error];
+  });
+  assert.equal(bad[0], 400);
+  assert.match(bad[1], /sensor/);
+  assert.deepEqual(page.errors, [], 'no script errors');
+});
+
+test('a board of 100 emulated vessels loads and stays responsive', async () => {
+  const part = `usv_fdi_dash_${process.pid}_b`;
+  const dash = await dashboard('dashboard100', part);
+  start('emulate', ['emulate', ...dds(part), '--vessels', '100', '--first-mmsi', '990000001',
+                    '--status-rate', '1', '--event-rate', '5']);
+  const page = await newPage();
+  const t0 = Date.now();
+  await page.goto(dash.url);
+  await waitFor('100 vessel rows', async () =>
+    (await page.$$eval('#board tbody tr', (r) => r.length)) === 100, 60);
+  console.log(`100 vessels on the board ${(Date.now() - t0) / 1000} s after loading`);
+  // Responsive: a filter applies while updates keep arriving, and the page answers at once.
+  await page.selectOption('#f-vessel', '990000050');
+  const t1 = Date.now();
+  const probe = await page.evaluate(() => new Promise((r) => {
+    const s = performance.now();
+    requestAnimationFrame(() => r(performance.now() - s));
+  }));
+  const rows = await page.$$eval('#events tbody tr', (r) => r.map((x) => x.dataset.mmsi));
+  assert.ok(rows.every((m) => m === '990000050'), rows.join());
+  console.log(`frame after ${probe.toFixed(1)} ms, filter applied in ${Date.now() - t1} ms`);
+  assert.ok(probe < 2000, `a frame took ${probe} ms`);
+  await page.screenshot({ path: path.join(out, 'board100.png') });
+  assert.deepEqual(page.errors, [], 'no script errors');
+});
