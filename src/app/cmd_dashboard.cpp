@@ -18,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -84,10 +85,29 @@ class Hub {
     std::lock_guard<std::mutex> l(m_);
     return stop_;
   }
-  void ask(db::AckWork w) {
+  /// Queues an ack for the DDS thread; false when too many wait already.
+  bool ask(db::AckWork w) {
     std::lock_guard<std::mutex> l(m_);
+    if (acks_.size() >= kMaxQueued) return false;
     acks_.push_back(std::move(w));
+    return true;
   }
+  /// A live stream holds an HTTP thread: at most kMaxStreams at once, so that pages and
+  /// acknowledgements always find one.
+  bool open_stream() {
+    std::lock_guard<std::mutex> l(m_);
+    if (streams_ >= kMaxStreams) return false;
+    ++streams_;
+    return true;
+  }
+  void close_stream() {
+    std::lock_guard<std::mutex> l(m_);
+    --streams_;
+  }
+
+  static constexpr std::size_t kMaxQueued = 100;
+  static constexpr int kMaxStreams = 24;
+  static constexpr int kThreads = 32;
   std::vector<db::AckWork> take_asked() {
     std::lock_guard<std::mutex> l(m_);
     std::vector<db::AckWork> out;
@@ -101,6 +121,7 @@ class Hub {
   std::string board_ = "{}";
   std::uint64_t version_ = 0;
   bool stop_ = false;
+  int streams_ = 0;
   std::vector<db::AckWork> acks_;
 };
 
@@ -109,7 +130,31 @@ void reply_json(httplib::Response& res, int status, const json& j) {
   res.set_content(j.dump(), "application/json");
 }
 
-void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a) {
+/// The Host values a request may carry (empty: any, when listening on every address): a page
+/// served under another name (DNS rebinding) gets nothing.
+std::set<std::string> allowed_hosts(const std::string& host, int port) {
+  if (host.empty() || host == "0.0.0.0" || host == "::") return {};
+  const std::string p = ":" + std::to_string(port);
+  std::set<std::string> out{(host.find(':') != std::string::npos ? "[" + host + "]" : host) + p};
+  if (host == "127.0.0.1" || host == "::1" || host == "localhost") {
+    out.insert({"localhost" + p, "127.0.0.1" + p, "[::1]" + p});
+  }
+  return out;
+}
+
+void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
+            const std::set<std::string>& hosts) {
+  svr.set_payload_max_length(4096);  // an ack request is a few dozen bytes
+  svr.set_keep_alive_timeout(1);
+  svr.set_pre_routing_handler([hosts](const httplib::Request& req, httplib::Response& res) {
+    if (hosts.empty() || hosts.count(req.get_header_value("Host")) > 0) {
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
+    reply_json(res, 421,
+               {{"error", "this dashboard does not serve the host '" +
+                              escape_text(req.get_header_value("Host")) + "'"}});
+    return httplib::Server::HandlerResponse::Handled;
+  });
   const auto page = [](const char* body, const char* type) {
     return [body, type](const httplib::Request&, httplib::Response& res) {
       res.set_header("Content-Security-Policy", "default-src 'self'");
@@ -128,11 +173,17 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a) {
     res.set_content(hub.current(), "application/json");
   });
   svr.Get("/api/stream", [&hub](const httplib::Request&, httplib::Response& res) {
+    if (!hub.open_stream()) {
+      res.set_header("Retry-After", "5");
+      reply_json(res, 503, {{"error", "too many live pages on this dashboard"}});
+      return;
+    }
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Accel-Buffering", "no");
     auto seen = std::make_shared<std::uint64_t>(0);
     res.set_chunked_content_provider(
-        "text/event-stream", [&hub, seen](std::size_t, httplib::DataSink& sink) {
+        "text/event-stream",
+        [&hub, seen](std::size_t, httplib::DataSink& sink) {
           std::string board;
           if (hub.next(seen.get(), &board, std::chrono::milliseconds(2000))) {
             const std::string msg = "data: " + board + "\n\n";
@@ -144,7 +195,8 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a) {
           }
           static const std::string keepalive = ": keepalive\n\n";
           return sink.write(keepalive.data(), keepalive.size());
-        });
+        },
+        [&hub](bool) { hub.close_stream(); });
   });
   svr.Post("/api/ack", [&hub, &a](const httplib::Request& req, httplib::Response& res) {
     if (a.read_only) {
@@ -152,6 +204,19 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a) {
                  {{"error", "this dashboard is read-only (observers cannot acknowledge)"}});
       spdlog::warn("refused an acknowledgement from {}: the dashboard is read-only",
                    req.remote_addr);
+      return;
+    }
+    // JSON only (a cross-site form or a "simple" fetch cannot send it without the browser
+    // asking first, and nothing here allows that), and from this dashboard's own page.
+    const std::string origin = req.get_header_value("Origin");
+    if (!origin.empty() && origin != "http://" + req.get_header_value("Host")) {
+      reply_json(res, 403, {{"error", "acknowledgements come from this dashboard's own page"}});
+      spdlog::warn("refused an acknowledgement from {}: origin {}", req.remote_addr,
+                   escape_text(origin));
+      return;
+    }
+    if (req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
+      reply_json(res, 415, {{"error", "the body must be application/json"}});
       return;
     }
     db::AckWork w;
@@ -162,8 +227,11 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a) {
                    escape_text(why));
       return;
     }
+    if (!hub.ask(std::move(w))) {
+      reply_json(res, 429, {{"error", "too many acknowledgements waiting; try again"}});
+      return;
+    }
     reply_json(res, 202, {{"queued", true}});
-    hub.ask(std::move(w));
   });
 }
 
@@ -185,42 +253,89 @@ bool split_listen(const std::string& s, std::string* host, int* port) {
   return true;
 }
 
-/// The acknowledgements the DDS thread sends and follows until the sidecar's verdict.
+/// The acknowledgements the DDS thread sends and follows until the sidecar's answer. An ack is
+/// "accepted" only when the instance's next event (sequence + 1) is an acknowledged state whose
+/// message names this operator (the sidecar writes "acknowledged by <operator>"); "refused" when
+/// the sidecar will not take it (stale sequence, nothing to acknowledge: refusal_reason) or the
+/// next event is something else; "unconfirmed" when no answer came within --ack-timeout (it is
+/// still watched for kWatch s, and settled if the answer comes).
 class Acks {
  public:
+  static constexpr std::size_t kMaxPending = 100;
+  static constexpr double kWatch = 60.0;  ///< [s] an unconfirmed ack is still watched this long
+
   Acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a)
       : ctx_(ctx), view_(view), a_(a) {}
 
   void ask(const db::AckWork& w) {
     Pending p;
     p.work = w;
+    p.work.operator_id = w.operator_id.substr(0, 63);
     p.id = ++next_id_;
     p.asked = mono_now();
     db::AckOutcome o;
     o.mmsi = w.req.mmsi;
     o.sensor = w.req.sensor;
     o.sequence = w.req.sequence;
-    o.operator_id = w.operator_id;
+    o.operator_id = p.work.operator_id;
     o.sent = wall_now();
     o.state = "pending";
     outcomes_.push_front({p.id, o});
     while (outcomes_.size() > 100) outcomes_.pop_back();
     spdlog::info("ack asked from the dashboard: MMSI {} {} #{} by {}", w.req.mmsi,
-                 to_string(w.req.sensor), w.req.sequence, escape_text(w.operator_id));
+                 to_string(w.req.sensor), w.req.sequence, escape_text(p.work.operator_id));
+    for (const Pending& q : pending_) {
+      if (q.work.req.mmsi == w.req.mmsi && q.work.req.sensor == w.req.sensor &&
+          q.work.req.sequence == w.req.sequence && q.state == "pending") {
+        settle(p.id, "refused",
+               "an acknowledgement of this event by " + escape_text(q.work.operator_id) +
+                   " is already on its way");
+        return;
+      }
+    }
+    if (pending_.size() >= kMaxPending) {
+      settle(p.id, "refused", "too many acknowledgements waiting for an answer");
+      return;
+    }
     pending_.push_back(p);
   }
 
-  /// Writes what can be written, and settles what the sidecar has answered. True if an outcome
-  /// changed.
+  /// Every fault event the view shows (FleetView::on_row): the sidecar's answers.
+  void on_event(const Row& r) {
+    for (Pending& p : pending_) {
+      const AckRequest& req = p.work.req;
+      if (p.written < 0 || r.mmsi != req.mmsi || r.ev.sensor != req.sensor ||
+          r.ev.sequence <= req.sequence || p.state == "done") {
+        continue;
+      }
+      const std::string by = "acknowledged by " + escape_text(p.work.operator_id);
+      const bool acked =
+          r.ev.state == FaultState::kActiveAcknowledged || r.ev.state == FaultState::kAcknowledged;
+      if (r.ev.sequence == req.sequence + 1 && acked && r.ev.message == by) {
+        settle(p.id, "accepted", "");
+      } else if (r.ev.sequence == req.sequence + 1) {
+        settle(p.id, "refused",
+               "the event moved on to #" + std::to_string(r.ev.sequence) + " " +
+                   to_string(r.ev.state) + ": " + escape_text(r.ev.message));
+      } else {
+        settle(p.id, "unconfirmed",
+               "the event moved on to #" + std::to_string(r.ev.sequence) +
+                   " before its answer was seen");
+      }
+      p.state = "done";
+      changed_ = true;
+    }
+  }
+
+  /// Writes what can be written, times out what is not answered. True if an outcome changed.
   bool turn() {
-    bool changed = false;
+    bool changed = changed_;
+    changed_ = false;
     const double now = mono_now();
     for (auto it = pending_.begin(); it != pending_.end();) {
-      if (step(&*it, now, &changed)) {
-        it = pending_.erase(it);
-      } else {
-        ++it;
-      }
+      if (it->state != "done") step(&*it, now, &changed);
+      const bool over = it->state == "done" || (it->written >= 0 && now - it->written >= kWatch);
+      it = over ? pending_.erase(it) : it + 1;
     }
     return changed;
   }
@@ -235,8 +350,9 @@ class Acks {
   struct Pending {
     db::AckWork work;
     std::uint64_t id = 0;
-    double asked = 0.0;   ///< [mono s]
-    double written = -1;  ///< [mono s]; < 0: not yet
+    double asked = 0.0;             ///< [mono s]
+    double written = -1;            ///< [mono s]; < 0: not yet
+    std::string state = "pending";  ///< pending, unconfirmed (still watched) or done
   };
 
   void settle(std::uint64_t id, const std::string& state, const std::string& reason) {
@@ -249,61 +365,56 @@ class Acks {
       if (state == "accepted") {
         spdlog::info("ack {} by {} accepted", who, escape_text(o.operator_id));
       } else {
-        spdlog::warn("ack {} by {} not accepted: {}", who, escape_text(o.operator_id), reason);
+        spdlog::warn("ack {} by {} {}: {}", who, escape_text(o.operator_id),
+                     state == "refused" ? "not accepted" : "unconfirmed", reason);
       }
     }
   }
 
-  /// One pending ack; true when it is settled.
-  bool step(Pending* p, double now, bool* changed) {
+  /// One pending ack: written once its instance is known and a sidecar reads acks; timed out.
+  void step(Pending* p, double now, bool* changed) {
     const AckRequest& req = p->work.req;
     const RowKey key{req.mmsi, static_cast<int>(req.sensor)};
+    const Row* row = view_.row(key);
     if (p->written < 0) {
-      fdds::DataWriter* w = writer(req.mmsi);
-      if (w == nullptr) {
-        settle(p->id, "refused", "cannot write acknowledgements to this vessel (see the log)");
-        *changed = true;
-        return true;
-      }
+      // No writer before the instance is known: a request for any MMSI must not make one.
+      fdds::DataWriter* w = row == nullptr ? nullptr : writer(req.mmsi);
       fdds::PublicationMatchedStatus st;
-      w->get_publication_matched_status(st);
-      const Row* row = view_.row(key);
-      if (st.current_count == 0 || row == nullptr) {
-        if (now - p->asked < a_.discovery_timeout) return false;
+      if (w != nullptr) w->get_publication_matched_status(st);
+      if (row == nullptr || w == nullptr || st.current_count == 0) {
+        if (now - p->asked < a_.discovery_timeout && (row == nullptr || w != nullptr)) return;
         settle(p->id, "refused",
                row == nullptr ? "no latched event of this vessel and sensor is known here"
+               : w == nullptr ? "cannot write acknowledgements to this vessel (see the log)"
                               : "no sidecar of this vessel subscribes to acknowledgements");
+        p->state = "done";
         *changed = true;
-        return true;
+        return;
       }
       if (ack_already_past(req, row)) {
         settle(p->id, "refused", refusal_reason(req, row));
+        p->state = "done";
         *changed = true;
-        return true;
+        return;
       }
       fdi::FaultAck ack;
       ack.mmsi(req.mmsi);
       ack.sensor(static_cast<std::uint8_t>(req.sensor));
       ack.sequence(req.sequence);
-      ack.operator_id(p->work.operator_id.substr(0, 63).c_str());
+      ack.operator_id(p->work.operator_id.c_str());
       ack.stamp(wall_now());
       ack.incarnation(row->ev.incarnation);
       dds::write(*w, ack);
       p->written = now;
-      return false;
+      return;
     }
-    const Row* row = view_.row(key);
-    if (ack_confirmed(req, row)) {
-      settle(p->id, "accepted", "");
+    if (p->state == "pending" && now - p->written >= a_.ack_timeout) {
+      settle(p->id, "unconfirmed",
+             fmt::format("no answer from the sidecar within {:g} s ({})", a_.ack_timeout,
+                         refusal_reason(req, row)));
+      p->state = "unconfirmed";
       *changed = true;
-      return true;
     }
-    if (now - p->written >= a_.ack_timeout) {
-      settle(p->id, "refused", refusal_reason(req, row));
-      *changed = true;
-      return true;
-    }
-    return false;
   }
 
   fdds::DataWriter* writer(std::uint32_t mmsi) {
@@ -330,6 +441,7 @@ class Acks {
   std::vector<Pending> pending_;
   std::deque<std::pair<std::uint64_t, db::AckOutcome>> outcomes_;
   std::uint64_t next_id_ = 0;
+  bool changed_ = false;
 };
 
 std::string make_board(const FleetView& view, const db::EventHistory& events, const Acks& acks,
@@ -350,7 +462,29 @@ std::string make_board(const FleetView& view, const db::EventHistory& events, co
   in.conflicts = view.conflicts();
   json j = db::board_json(in, events, acks.outcomes(), wall_now());
   j["can_ack"] = can_ack;
-  return j.dump();
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+/// The DDS thread's loop: the fleet view, the acks, the board; until a stop signal or the
+/// credentials expire. Returns the exit code.
+int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& events, Acks& acks,
+          Hub& hub, const CredentialExpiry& expiry) {
+  double last_board = mono_now();
+  for (;;) {
+    bool changed = view.poll(0.1);
+    for (const db::AckWork& w : hub.take_asked()) acks.ask(w);
+    changed = acks.turn() || changed;
+    const double now = mono_now();
+    if (changed || now - last_board >= 1.0) {
+      hub.publish(make_board(view, events, acks, !a.read_only));
+      last_board = now;
+    }
+    if (expiry.expired(wall_now())) {
+      spdlog::error("{}", expired_message(expiry));
+      return kExitFailure;
+    }
+    if (wait_for_stop_signal(0.0) != 0) return kExitOk;
+  }
 }
 
 int run_dashboard(DashboardArgs& a) {
@@ -370,14 +504,16 @@ int run_dashboard(DashboardArgs& a) {
   int rc = join_fleet_domain(a.m, &ctx, &view, &expiry);
   if (rc != kExitOk) return rc;
   db::EventHistory events(a.history);
-  view->on_row([&events](const Row& r) { events.add(r); });
   Acks acks(*ctx, *view, a.m);
+  view->on_row([&events, &acks](const Row& r) {
+    events.add(r);
+    acks.on_event(r);
+  });
   Hub hub;
   hub.publish(make_board(*view, events, acks, !a.read_only));
 
   httplib::Server svr;
-  svr.new_task_queue = [] { return new httplib::ThreadPool(32); };
-  routes(svr, hub, a);
+  svr.new_task_queue = [] { return new httplib::ThreadPool(Hub::kThreads); };
   const int bound =
       port == 0 ? svr.bind_to_any_port(host) : (svr.bind_to_port(host, port) ? port : -1);
   if (bound < 0) {
@@ -385,27 +521,20 @@ int run_dashboard(DashboardArgs& a) {
                   a.listen);
     return kExitFailure;
   }
+  routes(svr, hub, a, allowed_hosts(host, bound));
   std::thread http([&svr] { svr.listen_after_bind(); });
+  // svr.stop() does nothing before the server runs: wait for it (bounded) so that a stop joins.
+  for (int i = 0; i < 500 && !svr.is_running(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   spdlog::info("dashboard on http://{}:{}/ ({}; DDS domain {}): running",
                host.find(':') != std::string::npos ? "[" + host + "]" : host, bound,
                a.read_only ? "read-only" : "operators may acknowledge", ctx->config().domain_id);
-
-  double last_board = mono_now();
-  for (;;) {
-    bool changed = view->poll(0.1);
-    for (const db::AckWork& w : hub.take_asked()) acks.ask(w);
-    changed = acks.turn() || changed;
-    const double now = mono_now();
-    if (changed || now - last_board >= 1.0) {
-      hub.publish(make_board(*view, events, acks, !a.read_only));
-      last_board = now;
-    }
-    if (expiry.expired(wall_now())) {
-      spdlog::error("{}", expired_message(expiry));
-      rc = kExitFailure;
-      break;
-    }
-    if (wait_for_stop_signal(0.0) != 0) break;
+  try {
+    rc = serve(a, *view, events, acks, hub, expiry);
+  } catch (const std::exception& e) {
+    spdlog::error("dashboard: {}", e.what());
+    rc = kExitFailure;
   }
   hub.stop();
   svr.stop();

@@ -68,8 +68,9 @@ try {
                           '--event-rate', String(opt['event-rate']),
                           '--duration', String(opt.seconds)]);
   await sleep(opt.seconds * 1000 + 3000);
-  const seen = await page.evaluate(() => window.__seen);
   const board = await page.evaluate(async () => (await fetch('/api/board')).json());
+  await sleep(2000);  // every event of that board has had time to be pushed and drawn
+  const seen = await page.evaluate(() => window.__seen);
   const lat = [];
   let missing = 0;
   for (const e of board.events) {

@@ -83,6 +83,21 @@ TEST(DashboardBoard, TheBoardHasEveryVesselHeardLatchedOrOnTheRoster) {
   EXPECT_NO_THROW(nlohmann::json::parse(j.dump()));
 }
 
+TEST(DashboardBoard, APeersTextIsEscapedSoTheBoardIsAlwaysValidJson) {
+  // A message cut inside a multi-byte character, or a peer's bytes: never raw in the JSON.
+  Row r = row(7, Sensor::kGyro, FaultState::kRaised, 1);
+  r.ev.message = "bias \xe2\x82 \xff\x1b[31m";
+  EventHistory h;
+  h.add(r);
+  BoardInput in;
+  in.rows[{7, static_cast<int>(Sensor::kGyro)}] = r;
+  const auto j = board_json(in, h, {}, 101.0);
+  std::string text;
+  ASSERT_NO_THROW(text = j.dump());
+  EXPECT_EQ(j["events"][0]["message"], "bias \\xe2\\x82 \\xff\\x1b[31m");
+  EXPECT_EQ(text.find('\x1b'), std::string::npos);
+}
+
 TEST(DashboardBoard, AnAckRequestIsCheckedFieldByField) {
   AckWork w;
   std::string why;

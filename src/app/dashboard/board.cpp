@@ -3,6 +3,7 @@
 #include <cmath>
 #include <set>
 
+#include "usv_fdi/core/text.hpp"
 #include "usv_fdi/pipeline/pipeline.hpp"
 
 namespace usvfdi::app::dashboard {
@@ -46,7 +47,7 @@ json row_json(const Row& r, double now) {
               {"t", num(e.t)},
               {"onset_time", num(e.onset_time)},
               {"detection_time", num(e.detection_time)},
-              {"message", e.message},
+              {"message", escape_text(e.message)},  // a peer's text: never raw
               {"written", num(r.written)},
               {"age_s", num(now - r.written)},
               {"alive", r.alive}};
@@ -68,7 +69,7 @@ json status_json(const VesselStatus& v) {
               {"isolation_paused", pipeline::pause_reason_names(s.isolation_paused())},
               {"samples", s.samples()},
               {"dropped", s.dropped()},
-              {"message", s.message().to_string()},
+              {"message", escape_text(s.message().to_string())},
               {"surge_speed", num(s.surge_speed())},
               {"speed_ratio", num(s.speed_ratio())},
               {"written", num(v.written)},

@@ -11,6 +11,9 @@ const STATE_WORDS = {
   'normal': 'normal',
 };
 let board = null;
+const sent = new Set();  // mmsi/sensor/sequence acknowledged from this page
+let holding = false;     // a pointer is down: the board waits, so that a click is not lost
+let stale = false;       // a board arrived while holding
 
 function el(tag, attrs, ...children) {
   const e = document.createElement(tag);
@@ -45,6 +48,11 @@ function sensorCell(v, sensor) {
     'data-sequence': r.sequence,
     'data-written': r.written,
   });
+  // The board is rebuilt on every push: the flashing keeps its phase on the wall clock, so a
+  // rebuild does not restart it (an active-unacknowledged alert flashes however often it comes).
+  if (r.presentation === 'active-unacknowledged') {
+    cell.style.animationDelay = `-${Date.now() % 1000}ms`;
+  }
   cell.append(el('div', { class: 'state' }, STATE_WORDS[r.presentation] || r.presentation));
   cell.append(el('div', { class: 'detail' },
     `${r.kind} · C_a ${fixed(r.c_a, 2)} · C_g ${fixed(r.c_g, 2)} · #${r.sequence} · ${age(r.age_s)} ago`));
@@ -53,7 +61,8 @@ function sensorCell(v, sensor) {
   if (ackable && board.can_ack) {
     const b = el('button', { class: 'ack', 'data-mmsi': v.mmsi, 'data-sensor': sensor,
                              'data-sequence': r.sequence }, 'Acknowledge #' + r.sequence);
-    b.addEventListener('click', () => acknowledge(v.mmsi, sensor, r.sequence));
+    b.disabled = sent.has(`${v.mmsi}/${sensor}/${r.sequence}`);
+    b.addEventListener('click', () => acknowledge(v.mmsi, sensor, r.sequence, b));
     cell.append(b);
   }
   td.append(cell);
@@ -131,7 +140,7 @@ function render() {
   renderAcks();
 }
 
-async function acknowledge(mmsi, sensor, sequence) {
+async function acknowledge(mmsi, sensor, sequence, button) {
   const out = document.getElementById('ack-result');
   const operator = document.getElementById('operator').value.trim();
   if (!operator) {
@@ -140,11 +149,16 @@ async function acknowledge(mmsi, sensor, sequence) {
     return;
   }
   localStorage.setItem('usv-fdi-operator', operator);
+  const key = `${mmsi}/${sensor}/${sequence}`;
+  if (sent.has(key)) return;
+  sent.add(key);
+  button.disabled = true;
   const r = await fetch('/api/ack', {
     method: 'POST', headers: { 'Content-Type': 'application/json' },
     body: JSON.stringify({ mmsi, sensor, sequence, operator }),
   });
   const reply = await r.json().catch(() => ({ error: r.statusText }));
+  if (!r.ok) sent.delete(key);
   out.textContent = r.ok ? `Acknowledgement of ${mmsi} ${sensor} #${sequence} sent.`
                          : `Not sent: ${reply.error}`;
   out.className = r.ok ? 'accepted' : 'refused';
@@ -154,12 +168,21 @@ function connect() {
   const link = document.getElementById('link');
   const es = new EventSource('/api/stream');
   es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
-  es.onmessage = (m) => { board = JSON.parse(m.data); render(); };
+  es.onmessage = (m) => {
+    board = JSON.parse(m.data);
+    if (holding) stale = true; else render();
+  };
   es.onerror = () => { link.textContent = 'reconnecting'; link.className = 'link down'; };
 }
 
 for (const id of ['f-vessel', 'f-sensor', 'f-state']) {
   document.getElementById(id).addEventListener('change', () => board && renderEvents());
 }
+document.addEventListener('pointerdown', () => { holding = true; });
+document.addEventListener('pointerup', () => {
+  holding = false;
+  // after the click event of this press has run
+  setTimeout(() => { if (stale && !holding) { stale = false; render(); } }, 0);
+});
 document.getElementById('operator').value = localStorage.getItem('usv-fdi-operator') || '';
 connect();
