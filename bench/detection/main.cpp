@@ -100,7 +100,7 @@ int run(int argc, char** argv, CommandLine* cl) {
   const auto tables = summarise(cases, results);
 
   const std::string head = run_header(argc, argv, *cl, cases.size(), secs);
-  const std::string md = to_markdown(tables, head);
+  const std::string md = to_markdown(tables, head, breakdown(cases, results));
   std::cout << md;
   if (!cl->md_file.empty() && !write_output(cl->md_file, md)) return 4;
   if (!cl->json_file.empty() &&

@@ -1,7 +1,9 @@
 // Markdown and JSON outputs of the detection benchmark.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <tuple>
 
 #include "runner.hpp"
 
@@ -160,10 +162,93 @@ std::string to_overview(const std::vector<TableSummary>& tables) {
   return o.str();
 }
 
-std::string to_markdown(const std::vector<TableSummary>& tables, const std::string& header) {
+std::string data_class(const Case& c) {
+  if (c.voyage == "course/calm") return "calm";
+  if (c.voyage == "voyage/sea3/mems") return "sea 3, MEMS";
+  if (c.subject.find("hsva") != std::string::npos) return "HSVA recorded";
+  return c.voyage;
+}
+
+std::vector<BreakdownRow> breakdown(const std::vector<Case>& cases,
+                                    const std::vector<CaseResult>& results) {
+  std::vector<BreakdownRow> rows;
+  const auto& kinds = standard_kinds();
+  auto row_of = [&rows](const std::string& data, Sensor sensor, FaultKind kind) -> BreakdownRow& {
+    for (BreakdownRow& r : rows) {
+      if (r.data == data && r.sensor == sensor && r.kind == kind) return r;
+    }
+    rows.push_back(BreakdownRow{});
+    rows.back().data = data;
+    rows.back().sensor = sensor;
+    rows.back().kind = kind;
+    return rows.back();
+  };
+  for (const CaseResult& r : results) {
+    const Case& c = cases.at(r.index);
+    const std::string data = data_class(c);
+    // Every method scores the same faults; count them once, from the engine's scores.
+    for (std::size_t i = 0; i < r.m[kEngine].score.faults.size(); ++i) {
+      const InjectedFault& f = r.m[kEngine].score.faults[i].fault;
+      if (std::find(kinds.begin(), kinds.end(), f.kind) == kinds.end()) continue;
+      BreakdownRow& row = row_of(data, f.sensor, f.kind);
+      ++row.faults;
+      for (int k = 0; k < kMethods; ++k) {
+        if (i >= r.m[k].score.faults.size()) continue;
+        const FaultScore& s = r.m[k].score.faults[i];
+        if (!s.detected) continue;
+        ++row.m[k][0];
+        if (s.isolated) ++row.m[k][1];
+        if (s.delay <= BreakdownRow::kEarly) ++row.m[k][2];
+      }
+    }
+  }
+  // Data classes in the order first seen; within one, by sensor, then in table order of kinds.
+  std::vector<std::string> order;
+  for (const BreakdownRow& r : rows) {
+    if (std::find(order.begin(), order.end(), r.data) == order.end()) order.push_back(r.data);
+  }
+  auto rank = [&](const BreakdownRow& r) {
+    const auto d = std::find(order.begin(), order.end(), r.data) - order.begin();
+    const auto k = std::find(kinds.begin(), kinds.end(), r.kind) - kinds.begin();
+    return std::make_tuple(d, static_cast<int>(r.sensor), k);
+  };
+  std::stable_sort(rows.begin(), rows.end(),
+                   [&](const BreakdownRow& a, const BreakdownRow& b) { return rank(a) < rank(b); });
+  return rows;
+}
+
+namespace {
+
+/// Where the faults are missed: a row per data class, sensor and kind.
+std::string to_breakdown(const std::vector<BreakdownRow>& rows) {
+  std::ostringstream o;
+  o << "Where the faults are found and missed, over every table (detected / isolated / "
+       "detected within "
+    << fmt("%.0f", BreakdownRow::kEarly) << " s of the onset, of the faults):\n\n";
+  o << "| data | sensor | kind | faults |";
+  for (int k = 0; k < kMethods; ++k) o << " " << method_name(k) << " |";
+  o << "\n|---|---|---|---|";
+  for (int k = 0; k < kMethods; ++k) o << "---|";
+  o << "\n";
+  for (const BreakdownRow& r : rows) {
+    o << "| " << r.data << " | " << to_string(r.sensor) << " | " << to_string(r.kind) << " | "
+      << r.faults << " |";
+    for (int k = 0; k < kMethods; ++k) {
+      o << " " << r.m[k][0] << " / " << r.m[k][1] << " / " << r.m[k][2] << " |";
+    }
+    o << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace
+
+std::string to_markdown(const std::vector<TableSummary>& tables, const std::string& header,
+                        const std::vector<BreakdownRow>& rows) {
   std::ostringstream o;
   if (!header.empty()) o << header << "\n\n";
   o << to_overview(tables) << "\n";
+  if (!rows.empty()) o << to_breakdown(rows) << "\n";
   for (const TableSummary& t : tables) {
     o << "#### " << t.name << " (" << t.runs << " runs, " << fmt("%.1f", t.hours)
       << " h of data)\n\n";

@@ -170,8 +170,27 @@ std::vector<CaseResult> run_all(const std::vector<Case>& cases, const BenchOptio
 
 /// Outputs. The overview: one row per table with each method's key figures.
 std::string to_overview(const std::vector<TableSummary>& tables);
-/// The header, the overview, then every table with its per-kind breakdown.
-std::string to_markdown(const std::vector<TableSummary>& tables, const std::string& header);
+/// Where the faults are found and missed, over every table: one row per kind of data
+/// (`data_class`), faulty sensor and standard kind.
+struct BreakdownRow {
+  std::string data;  ///< data_class of the runs
+  Sensor sensor = Sensor::kUnknown;
+  FaultKind kind = FaultKind::kUnknown;
+  int faults = 0;
+  /// Per method: detected, isolated, detected within kEarly of the onset.
+  std::array<std::array<int, 3>, kMethods> m{};
+  static constexpr double kEarly = 15.0;  ///< [s]: a 10 sigma / 30 s ramp is at 5 sigma
+};
+/// The kind of data a case is: "calm" (course/calm), "sea 3, MEMS" (voyage/sea3/mems), or
+/// "HSVA recorded" (the real data), else its voyage's name.
+std::string data_class(const Case& c);
+/// The rows in the order data class, sensor, kind (first seen), standard kinds only.
+std::vector<BreakdownRow> breakdown(const std::vector<Case>& cases,
+                                    const std::vector<CaseResult>& results);
+/// The header, the overview, where the faults are missed (when rows are given), then every
+/// table with its per-kind breakdown.
+std::string to_markdown(const std::vector<TableSummary>& tables, const std::string& header,
+                        const std::vector<BreakdownRow>& rows = {});
 std::string to_json(const std::vector<Case>& cases, const std::vector<CaseResult>& results,
                     const std::vector<TableSummary>& tables, const std::string& header);
 

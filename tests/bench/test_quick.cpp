@@ -134,6 +134,45 @@ TEST(BenchQuick, HarnessWorksAndTheOracleDetectsTheFaults) {
     }
   }
   EXPECT_GE(sim_detected, 0.9 * sim_faults);
+
+  // Where the faults are missed: the rows cover every fault of every table once, per data
+  // class, sensor and kind, and add up to each method's totals; early detections are a part
+  // of the detected, isolated ones too.
+  const std::vector<BreakdownRow> rows = breakdown(cases, results);
+  std::map<std::string, int> class_faults;
+  for (const Case& c : cases) {
+    if (c.faulty) ++class_faults[data_class(c)];
+  }
+  EXPECT_EQ(class_faults.count("calm"), 1u);  // the quick mode's only voyage
+  EXPECT_EQ(class_faults.count("HSVA recorded"), opt.realdata_dir.empty() ? 0u : 1u);
+  std::map<std::string, int> row_faults;
+  std::array<std::array<int, 2>, kMethods> sums{};
+  for (const BreakdownRow& r : rows) {
+    SCOPED_TRACE(r.data + " " + to_string(r.sensor) + " " + to_string(r.kind));
+    EXPECT_NE(r.sensor, Sensor::kUnknown);
+    row_faults[r.data] += r.faults;
+    for (int k = 0; k < kMethods; ++k) {
+      EXPECT_LE(r.m[k][0], r.faults);
+      EXPECT_LE(r.m[k][1], r.m[k][0]);
+      EXPECT_LE(r.m[k][2], r.m[k][0]);
+      sums[k][0] += r.m[k][0];
+      sums[k][1] += r.m[k][1];
+    }
+  }
+  EXPECT_EQ(row_faults, class_faults);
+  for (int k = 0; k < kMethods; ++k) {
+    int detected = 0, isolated = 0;
+    for (const TableSummary& t : tables) {
+      detected += t.m[k].detected;
+      isolated += t.m[k].isolated;
+    }
+    EXPECT_EQ(sums[k][0], detected) << method_name(k);
+    EXPECT_EQ(sums[k][1], isolated) << method_name(k);
+  }
+  const std::string md = to_markdown(tables, "quick", rows);
+  EXPECT_NE(md.find("| calm | gyro | bias | " + std::to_string(class_faults["calm"] / 10) + " |"),
+            std::string::npos);
+
   // Per run, too: the JSON names every run.
   const std::string json = to_json(cases, results, tables, "quick");
   EXPECT_NE(json.find("\"oracle\""), std::string::npos);
