@@ -3,7 +3,8 @@
 // ownership), plus an HTTP server (cpp-httplib) on a configurable address that serves the page
 // carried in the binary (dashboard/web/), the board as JSON (/api/board), the board pushed on
 // every change and once a second (server-sent events, /api/stream) and acknowledgements
-// (/api/ack, written as FaultAck by the DDS thread, their outcome shown on the board).
+// (/api/ack, written as FaultAck by the DDS thread, their outcome shown on the board), and the
+// fleet's Prometheus metrics (/metrics, refreshed once a second).
 //
 // Threads: the main thread owns DDS and the fleet view; the HTTP server's threads see only the
 // Hub (the latest board as text, and the queue of acknowledgements asked for).
@@ -29,6 +30,7 @@
 #include "commands.hpp"
 #include "credentials.hpp"
 #include "dashboard/board.hpp"
+#include "dashboard/metrics.hpp"
 #include "dashboard_assets.hpp"
 #include "dds_options.hpp"
 #include "fleet_view.hpp"
@@ -73,6 +75,14 @@ class Hub {
   std::string current() {
     std::lock_guard<std::mutex> l(m_);
     return board_;
+  }
+  void set_metrics(std::string text) {
+    std::lock_guard<std::mutex> l(m_);
+    metrics_ = std::move(text);
+  }
+  std::string metrics() {
+    std::lock_guard<std::mutex> l(m_);
+    return metrics_;
   }
   void stop() {
     {
@@ -119,6 +129,7 @@ class Hub {
   std::mutex m_;
   std::condition_variable cv_;
   std::string board_ = "{}";
+  std::string metrics_;
   std::uint64_t version_ = 0;
   bool stop_ = false;
   int streams_ = 0;
@@ -171,6 +182,10 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
   svr.Get("/api/board", [&hub](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
     res.set_content(hub.current(), "application/json");
+  });
+  svr.Get("/metrics", [&hub](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-cache");
+    res.set_content(hub.metrics(), "text/plain; version=0.0.4; charset=utf-8");
   });
   svr.Get("/api/stream", [&hub](const httplib::Request&, httplib::Response& res) {
     if (!hub.open_stream()) {
@@ -444,8 +459,7 @@ class Acks {
   bool changed_ = false;
 };
 
-std::string make_board(const FleetView& view, const db::EventHistory& events, const Acks& acks,
-                       bool can_ack) {
+db::BoardInput board_input(const FleetView& view) {
   db::BoardInput in;
   view.rows().for_each([&](const RowKey& k, const Row& r) { in.rows[k] = r; });
   if (view.vessels() != nullptr) {
@@ -460,6 +474,11 @@ std::string make_board(const FleetView& view, const db::EventHistory& events, co
   in.roster_never_heard = view.roster().never_heard(view.liveness());
   in.silent_after = view.liveness().silent_after();
   in.conflicts = view.conflicts();
+  return in;
+}
+
+std::string make_board(const db::BoardInput& in, const db::EventHistory& events, const Acks& acks,
+                       bool can_ack) {
   json j = db::board_json(in, events, acks.outcomes(), wall_now());
   j["can_ack"] = can_ack;
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
@@ -469,14 +488,20 @@ std::string make_board(const FleetView& view, const db::EventHistory& events, co
 /// credentials expire. Returns the exit code.
 int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& events, Acks& acks,
           Hub& hub, const CredentialExpiry& expiry) {
-  double last_board = mono_now();
+  double last_board = mono_now(), last_metrics = -1e9;
   for (;;) {
     bool changed = view.poll(0.1);
     for (const db::AckWork& w : hub.take_asked()) acks.ask(w);
     changed = acks.turn() || changed;
     const double now = mono_now();
     if (changed || now - last_board >= 1.0) {
-      hub.publish(make_board(view, events, acks, !a.read_only));
+      const db::BoardInput in = board_input(view);
+      hub.publish(make_board(in, events, acks, !a.read_only));
+      // The metrics follow the board at most once a second (a scrape is seconds apart).
+      if (now - last_metrics >= 1.0) {
+        hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
+        last_metrics = now;
+      }
       last_board = now;
     }
     if (expiry.expired(wall_now())) {
@@ -510,7 +535,11 @@ int run_dashboard(DashboardArgs& a) {
     acks.on_event(r);
   });
   Hub hub;
-  hub.publish(make_board(*view, events, acks, !a.read_only));
+  {
+    const db::BoardInput in = board_input(*view);
+    hub.publish(make_board(in, events, acks, !a.read_only));
+    hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
+  }
 
   httplib::Server svr;
   svr.new_task_queue = [] { return new httplib::ThreadPool(Hub::kThreads); };

@@ -156,6 +156,20 @@ test('a sidecar\'s faults on the board: raise, late browser, acknowledge, observ
   assert.notEqual(await page.getAttribute(cell(mmsi, 'gyro'), 'data-presentation'), 'active-unacknowledged');
   await waitLog(svc, 'by alice accepted', 10);
   assert.match(readLog(svc), new RegExp(`gyro #${Number(seq) + 1} \\w+ .*acknowledged by alice`));
+  // AND the dashboard's Prometheus text says the same (refreshed once a second)
+  const metric = (text, line) => new RegExp(`^${line.replace(/[{}"]/g, '\\$&')} (\\S+)$`, 'm').exec(text);
+  const scrape = async () => (await fetch(`${dash.url}metrics`)).text();
+  const lbl = `mmsi="${mmsi}",sensor="gyro"`;
+  const text = await waitFor('the acknowledgement in /metrics', async () => {
+    const t = await scrape();
+    const u = metric(t, `usv_fdi_fleet_fault_unacknowledged{${lbl}}`);
+    return u && u[1] === '0' && metric(t, 'usv_fdi_dashboard_acks{state="accepted"}')?.[1] === '1'
+      ? t : null;
+  }, 10);
+  assert.ok(Number(metric(text, `usv_fdi_fleet_raises_total{${lbl}}`)[1]) >= 1, text);
+  assert.match(metric(text, `usv_fdi_fleet_fault_active{${lbl}}`)?.[1] ?? '', /^[01]$/, text);
+  assert.equal(metric(text, `usv_fdi_fleet_silent{mmsi="${mmsi}"}`)?.[1], '0', text);
+  assert.match(text, /# TYPE usv_fdi_fleet_raises_total counter/);
 
   // WHEN an observer's dashboard (--read-only) shows the same fleet
   const obs = await dashboard('observer', part, ['--read-only']);
@@ -212,6 +226,8 @@ test('a board of 100 emulated vessels loads and stays responsive', async () => {
   await waitFor('100 vessel rows', async () =>
     (await page.$$eval('#board tbody tr', (r) => r.length)) === 100, 60);
   console.log(`100 vessels on the board ${(Date.now() - t0) / 1000} s after loading`);
+  await waitFor('100 vessels in /metrics', async () =>
+    /^usv_fdi_fleet_vessels 100$/m.test(await (await fetch(`${dash.url}metrics`)).text()), 10);
   // Responsive: a filter applies while updates keep arriving, and the page answers at once.
   // a vessel with events (the emulator's events go to random vessels)
   const target = await waitFor('an event in the list', () => page.$eval(

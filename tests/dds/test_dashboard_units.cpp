@@ -1,12 +1,13 @@
 // Units of usv-fdi dashboard with no DDS and no HTTP in them (src/app/dashboard/board.cpp): the
-// IEC 62923 presentation, the event history, the board's JSON and the acknowledgement request's
-// checks. The page itself is tested in a real browser (tests/dashboard).
+// IEC 62923 presentation, the event history, the board's JSON, the acknowledgement request's
+// checks and the Prometheus text. The page itself is tested in a real browser (tests/dashboard).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
 #include "dashboard/board.hpp"
+#include "dashboard/metrics.hpp"
 
 namespace usvfdi::app::dashboard {
 namespace {
@@ -81,6 +82,53 @@ TEST(DashboardBoard, TheBoardHasEveryVesselHeardLatchedOrOnTheRoster) {
   EXPECT_TRUE(j["vessels"][2]["heard_age_s"].is_null());
   EXPECT_EQ(j["acks"][0]["reason"], "stale sequence");
   EXPECT_NO_THROW(nlohmann::json::parse(j.dump()));
+}
+
+TEST(DashboardMetrics, TheFleetIsExposedInPrometheusTextForm) {
+  BoardInput in;
+  in.rows[{7, static_cast<int>(Sensor::kGyro)}] = row(7, Sensor::kGyro, FaultState::kRaised, 3);
+  in.rows[{7, static_cast<int>(Sensor::kAccelerometer)}] =
+      row(7, Sensor::kAccelerometer, FaultState::kClearedUnacknowledged, 2);
+  in.rows[{8, static_cast<int>(Sensor::kGyro)}] =
+      row(8, Sensor::kGyro, FaultState::kActiveAcknowledged, 5);
+  in.heard_age[7] = 0.5;
+  in.silent[7] = false;
+  in.heard_age[8] = 9.0;
+  in.silent[8] = true;
+  in.roster_never_heard = {9};
+  in.statuses[7].st.converged(true);
+  in.statuses[7].st.armed(false);
+  in.conflicts = 1;
+  EventHistory h;
+  h.add(row(7, Sensor::kGyro, FaultState::kRaised, 1));
+  h.add(row(7, Sensor::kGyro, FaultState::kActiveAcknowledged, 2));
+  h.add(row(7, Sensor::kGyro, FaultState::kRaised, 3));
+  h.add(row(7, Sensor::kGyro, FaultState::kRaised, 3));  // a repeat: not a second raise
+  std::deque<AckOutcome> acks(2);
+  acks[0].state = "accepted";
+  acks[1].state = "refused";
+  const std::string t = fleet_metrics(in, h, acks);
+  const auto has = [&t](const std::string& line) {
+    return t.find("\n" + line + "\n") != std::string::npos;
+  };
+  EXPECT_NE(t.find("# TYPE usv_fdi_fleet_raises_total counter"), std::string::npos) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_vessels 3")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_silent{mmsi=\"7\"} 0")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_silent{mmsi=\"8\"} 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_silent{mmsi=\"9\"} 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_heard_age_seconds{mmsi=\"9\"} +Inf")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_fault_active{mmsi=\"7\",sensor=\"gyro\"} 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_fault_active{mmsi=\"7\",sensor=\"accelerometer\"} 0")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_fault_unacknowledged{mmsi=\"7\",sensor=\"accelerometer\"} 1"))
+      << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_fault_active{mmsi=\"8\",sensor=\"gyro\"} 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_fault_unacknowledged{mmsi=\"8\",sensor=\"gyro\"} 0")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_raises_total{mmsi=\"7\",sensor=\"gyro\"} 2")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_converged{mmsi=\"7\"} 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_armed{mmsi=\"7\"} 0")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_writer_conflicts 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_dashboard_acks{state=\"accepted\"} 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_dashboard_acks{state=\"pending\"} 0")) << t;
 }
 
 TEST(DashboardBoard, APeersTextIsEscapedSoTheBoardIsAlwaysValidJson) {

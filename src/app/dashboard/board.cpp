@@ -81,6 +81,7 @@ void EventHistory::add(const Row& r) {
   const auto it = last_sequence_.find(key);
   if (it != last_sequence_.end() && it->second == r.ev.sequence) return;
   last_sequence_[key] = r.ev.sequence;
+  if (r.ev.state == FaultState::kRaised) ++raises_[key];
   events_.push_front(r);
   while (events_.size() > capacity_) events_.pop_back();
 }

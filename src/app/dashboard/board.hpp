@@ -37,11 +37,14 @@ class EventHistory {
   void add(const Row& r);
   nlohmann::json to_json(double now) const;
   std::size_t size() const { return events_.size(); }
+  /// Raises recorded per instance (vessel, sensor), since the start (not bounded by capacity).
+  const std::map<RowKey, std::uint64_t>& raises() const { return raises_; }
 
  private:
   std::size_t capacity_;
   std::deque<Row> events_;
   std::map<RowKey, std::uint64_t> last_sequence_;
+  std::map<RowKey, std::uint64_t> raises_;
 };
 
 /// An acknowledgement asked for by a browser.
