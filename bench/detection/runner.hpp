@@ -184,7 +184,8 @@ struct BreakdownRow {
 /// The kind of data a case is: "calm" (course/calm), "sea 3, MEMS" (voyage/sea3/mems), or
 /// "HSVA recorded" (the real data), else its voyage's name.
 std::string data_class(const Case& c);
-/// The rows in the order data class, sensor, kind (first seen), standard kinds only.
+/// The rows ordered by data class (as first seen), sensor, kind (table order); standard kinds
+/// only. Markdown only (the JSON has every run).
 std::vector<BreakdownRow> breakdown(const std::vector<Case>& cases,
                                     const std::vector<CaseResult>& results);
 /// The header, the overview, where the faults are missed (when rows are given), then every

@@ -488,21 +488,24 @@ std::string make_board(const db::BoardInput& in, const db::EventHistory& events,
 /// credentials expire. Returns the exit code.
 int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& events, Acks& acks,
           Hub& hub, const CredentialExpiry& expiry) {
-  double last_board = mono_now(), last_metrics = -1e9;
+  double last_board = mono_now(), last_metrics = last_board;
   for (;;) {
     bool changed = view.poll(0.1);
     for (const db::AckWork& w : hub.take_asked()) acks.ask(w);
     changed = acks.turn() || changed;
     const double now = mono_now();
-    if (changed || now - last_board >= 1.0) {
+    const bool board = changed || now - last_board >= 1.0, metrics = now - last_metrics >= 1.0;
+    if (board || metrics) {
       const db::BoardInput in = board_input(view);
-      hub.publish(make_board(in, events, acks, !a.read_only));
-      // The metrics follow the board at most once a second (a scrape is seconds apart).
-      if (now - last_metrics >= 1.0) {
+      if (board) {
+        hub.publish(make_board(in, events, acks, !a.read_only));
+        last_board = now;
+      }
+      // The metrics once a second (a scrape is seconds apart), not on every change.
+      if (metrics) {
         hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
         last_metrics = now;
       }
-      last_board = now;
     }
     if (expiry.expired(wall_now())) {
       spdlog::error("{}", expired_message(expiry));

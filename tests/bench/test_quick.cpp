@@ -161,13 +161,20 @@ TEST(BenchQuick, HarnessWorksAndTheOracleDetectsTheFaults) {
   }
   EXPECT_EQ(row_faults, class_faults);
   for (int k = 0; k < kMethods; ++k) {
-    int detected = 0, isolated = 0;
+    int detected = 0, isolated = 0, early = 0, rows_early = 0;
     for (const TableSummary& t : tables) {
       detected += t.m[k].detected;
       isolated += t.m[k].isolated;
     }
+    for (const CaseResult& r : results) {
+      for (const FaultScore& f : r.m[k].score.faults) {
+        early += f.detected && f.delay <= BreakdownRow::kEarly ? 1 : 0;
+      }
+    }
+    for (const BreakdownRow& r : rows) rows_early += r.m[k][2];
     EXPECT_EQ(sums[k][0], detected) << method_name(k);
     EXPECT_EQ(sums[k][1], isolated) << method_name(k);
+    EXPECT_EQ(rows_early, early) << method_name(k);
   }
   const std::string md = to_markdown(tables, "quick", rows);
   EXPECT_NE(md.find("| calm | gyro | bias | " + std::to_string(class_faults["calm"] / 10) + " |"),

@@ -166,8 +166,10 @@ test('a sidecar\'s faults on the board: raise, late browser, acknowledge, observ
     return u && u[1] === '0' && metric(t, 'usv_fdi_dashboard_acks{state="accepted"}')?.[1] === '1'
       ? t : null;
   }, 10);
-  assert.ok(Number(metric(text, `usv_fdi_fleet_raises_total{${lbl}}`)[1]) >= 1, text);
-  assert.match(metric(text, `usv_fdi_fleet_fault_active{${lbl}}`)?.[1] ?? '', /^[01]$/, text);
+  assert.ok(Number(metric(text, `usv_fdi_fleet_raises_total{${lbl}}`)?.[1]) >= 1,
+            `a gyro raise counted:\n${text}`);
+  assert.match(metric(text, `usv_fdi_fleet_fault_active{${lbl}}`)?.[1] ?? '', /^[01]$/,
+               `the gyro instance's activity:\n${text}`);
   assert.equal(metric(text, `usv_fdi_fleet_silent{mmsi="${mmsi}"}`)?.[1], '0', text);
   assert.match(text, /# TYPE usv_fdi_fleet_raises_total counter/);
 

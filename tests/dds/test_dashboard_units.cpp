@@ -99,11 +99,25 @@ TEST(DashboardMetrics, TheFleetIsExposedInPrometheusTextForm) {
   in.statuses[7].st.converged(true);
   in.statuses[7].st.armed(false);
   in.conflicts = 1;
+  // The sidecar's sequence of one instance: raised, its kind refined (the same raise, next
+  // sequence), acknowledged, cleared, raised again; and a raise whose clearing was not seen.
   EventHistory h;
-  h.add(row(7, Sensor::kGyro, FaultState::kRaised, 1));
-  h.add(row(7, Sensor::kGyro, FaultState::kActiveAcknowledged, 2));
-  h.add(row(7, Sensor::kGyro, FaultState::kRaised, 3));
-  h.add(row(7, Sensor::kGyro, FaultState::kRaised, 3));  // a repeat: not a second raise
+  const auto ev = [](FaultState st, std::uint64_t seq, double detected, FaultKind kind) {
+    Row r = row(7, Sensor::kGyro, st, seq);
+    r.ev.detection_time = detected;
+    r.ev.kind = kind;
+    return r;
+  };
+  h.add(ev(FaultState::kRaised, 1, 10.0, FaultKind::kBias));
+  h.add(ev(FaultState::kRaised, 1, 10.0, FaultKind::kBias));   // a repeat
+  h.add(ev(FaultState::kRaised, 2, 10.0, FaultKind::kDrift));  // refined: no new raise
+  EXPECT_EQ(h.raises().at({7, static_cast<int>(Sensor::kGyro)}), 1u);
+  h.add(ev(FaultState::kActiveAcknowledged, 3, 10.0, FaultKind::kDrift));
+  h.add(ev(FaultState::kAcknowledged, 4, 10.0, FaultKind::kDrift));
+  h.add(ev(FaultState::kRaised, 5, 50.0, FaultKind::kBias));  // raised again
+  EXPECT_EQ(h.raises().at({7, static_cast<int>(Sensor::kGyro)}), 2u);
+  h.add(ev(FaultState::kRaised, 8, 90.0, FaultKind::kBias));  // 6, 7 (its clearing) not seen
+  EXPECT_EQ(h.raises().at({7, static_cast<int>(Sensor::kGyro)}), 3u);
   std::deque<AckOutcome> acks(2);
   acks[0].state = "accepted";
   acks[1].state = "refused";
@@ -123,10 +137,10 @@ TEST(DashboardMetrics, TheFleetIsExposedInPrometheusTextForm) {
       << t;
   EXPECT_TRUE(has("usv_fdi_fleet_fault_active{mmsi=\"8\",sensor=\"gyro\"} 1")) << t;
   EXPECT_TRUE(has("usv_fdi_fleet_fault_unacknowledged{mmsi=\"8\",sensor=\"gyro\"} 0")) << t;
-  EXPECT_TRUE(has("usv_fdi_fleet_raises_total{mmsi=\"7\",sensor=\"gyro\"} 2")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_raises_total{mmsi=\"7\",sensor=\"gyro\"} 3")) << t;
   EXPECT_TRUE(has("usv_fdi_fleet_converged{mmsi=\"7\"} 1")) << t;
   EXPECT_TRUE(has("usv_fdi_fleet_armed{mmsi=\"7\"} 0")) << t;
-  EXPECT_TRUE(has("usv_fdi_fleet_writer_conflicts 1")) << t;
+  EXPECT_TRUE(has("usv_fdi_fleet_writer_conflicts_total 1")) << t;
   EXPECT_TRUE(has("usv_fdi_dashboard_acks{state=\"accepted\"} 1")) << t;
   EXPECT_TRUE(has("usv_fdi_dashboard_acks{state=\"pending\"} 0")) << t;
 }

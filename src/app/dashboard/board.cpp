@@ -81,7 +81,14 @@ void EventHistory::add(const Row& r) {
   const auto it = last_sequence_.find(key);
   if (it != last_sequence_.end() && it->second == r.ev.sequence) return;
   last_sequence_[key] = r.ev.sequence;
-  if (r.ev.state == FaultState::kRaised) ++raises_[key];
+  if (r.ev.state == FaultState::kRaised) {
+    const auto last = last_state_.find(key);
+    const bool same_raise = last != last_state_.end() &&
+                            last->second.first == FaultState::kRaised &&
+                            last->second.second == r.ev.detection_time;
+    if (!same_raise) ++raises_[key];
+  }
+  last_state_[key] = {r.ev.state, r.ev.detection_time};
   events_.push_front(r);
   while (events_.size() > capacity_) events_.pop_back();
 }

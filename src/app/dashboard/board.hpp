@@ -37,7 +37,10 @@ class EventHistory {
   void add(const Row& r);
   nlohmann::json to_json(double now) const;
   std::size_t size() const { return events_.size(); }
-  /// Raises recorded per instance (vessel, sensor), since the start (not bounded by capacity).
+  /// Raises recorded per instance (vessel, sensor), since the start (not bounded by capacity):
+  /// an event in the raised state after one in another state, or with another detection time
+  /// (a raise whose clearing was not seen); a refined kind (the same raise republished with
+  /// the next sequence) is none, as in the sidecar's own count.
   const std::map<RowKey, std::uint64_t>& raises() const { return raises_; }
 
  private:
@@ -45,6 +48,7 @@ class EventHistory {
   std::deque<Row> events_;
   std::map<RowKey, std::uint64_t> last_sequence_;
   std::map<RowKey, std::uint64_t> raises_;
+  std::map<RowKey, std::pair<FaultState, double>> last_state_;  ///< state, detection time
 };
 
 /// An acknowledgement asked for by a browser.
@@ -64,7 +68,7 @@ struct AckOutcome {
   std::uint64_t sequence = 0;
   std::string operator_id;
   double sent = 0.0;   ///< wall clock [s since epoch]
-  std::string state;   ///< "pending", "accepted" or "refused"
+  std::string state;   ///< "pending", "accepted", "refused" or "unconfirmed"
   std::string reason;  ///< why it was refused ("" otherwise)
 };
 

@@ -82,12 +82,17 @@ std::string fleet_metrics(const BoardInput& in, const EventHistory& events,
     conv.Add(l).Set(v.st.converged() ? 1.0 : 0.0);
     armed.Add(l).Set(v.st.armed() ? 1.0 : 0.0);
   }
-  gauge(reg, "usv_fdi_fleet_writer_conflicts", "fault instances written by two sidecars")
+  prometheus::BuildCounter()
+      .Name("usv_fdi_fleet_writer_conflicts_total")
+      .Help(
+          "samples of another writer than an instance's owner (a second sidecar, a writer for "
+          "another vessel, an owner change) reported since the start")
+      .Register(reg)
       .Add({})
-      .Set(in.conflicts);
+      .Increment(in.conflicts);
 
   auto& ack = gauge(reg, "usv_fdi_dashboard_acks",
-                    "acknowledgements sent from this dashboard and kept, by state");
+                    "acknowledgements asked from this dashboard (the last 100 kept), by state");
   std::map<std::string, int> by_state{
       {"pending", 0}, {"accepted", 0}, {"refused", 0}, {"unconfirmed", 0}};
   for (const AckOutcome& a : acks) ++by_state[a.state];

@@ -23,11 +23,14 @@ namespace usvfdi::app::dashboard {
 ///   usv_fdi_fleet_fault_unacknowledged{mmsi,sensor} 1 while it waits for an acknowledgement
 ///                                                   (active-unacknowledged or
 ///                                                   rectified-unacknowledged)
-///   usv_fdi_fleet_raises_total{mmsi,sensor}         raises this dashboard has seen
+///   usv_fdi_fleet_raises_total{mmsi,sensor}         raises this dashboard has seen (a refined
+///                                                   kind is none)
 ///   usv_fdi_fleet_converged{mmsi}, usv_fdi_fleet_armed{mmsi}   0 or 1, from FdiStatus
-///   usv_fdi_fleet_writer_conflicts                  instances written by two sidecars
-///   usv_fdi_dashboard_acks{state}                   acknowledgements kept by state (pending,
-///                                                   accepted, refused, unconfirmed)
+///   usv_fdi_fleet_writer_conflicts_total            samples of another writer than an
+///                                                   instance's owner (FleetView::conflicts)
+///   usv_fdi_dashboard_acks{state}                   acknowledgements asked (the last 100 kept)
+///                                                   by state (pending, accepted, refused,
+///                                                   unconfirmed)
 std::string fleet_metrics(const BoardInput& in, const EventHistory& events,
                           const std::deque<AckOutcome>& acks);
 
