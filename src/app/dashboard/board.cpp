@@ -150,15 +150,19 @@ json EventHistory::to_json(double now) const {
   return out;
 }
 
-json board_json(const BoardInput& in, const EventHistory& events,
-                const std::deque<AckOutcome>& acks, double now) {
+std::set<std::uint32_t> board_vessels(const BoardInput& in) {
   std::set<std::uint32_t> mmsis;
   for (const auto& [key, row] : in.rows) mmsis.insert(key.first);
   for (const auto& [m, st] : in.statuses) mmsis.insert(m);
   for (const auto& [m, age] : in.heard_age) mmsis.insert(m);
   for (const std::uint32_t m : in.roster_never_heard) mmsis.insert(m);
+  return mmsis;
+}
+
+json board_json(const BoardInput& in, const EventHistory& events,
+                const std::deque<AckOutcome>& acks, double now) {
   json vessels = json::array();
-  for (const std::uint32_t m : mmsis) {
+  for (const std::uint32_t m : board_vessels(in)) {
     json v{{"mmsi", m}};
     json sensors = json::object();
     for (const auto& [key, row] : in.rows) {

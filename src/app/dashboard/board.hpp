@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -83,6 +84,8 @@ struct BoardInput {
   double silent_after = 5.0;
   int conflicts = 0;
 };
+/// The vessels on the board: heard, with a latched instance or on the roster, by MMSI.
+std::set<std::uint32_t> board_vessels(const BoardInput& in);
 nlohmann::json board_json(const BoardInput& in, const EventHistory& events,
                           const std::deque<AckOutcome>& acks, double now);
 

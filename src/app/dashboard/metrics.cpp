@@ -31,11 +31,7 @@ bool unacknowledged(FaultState s) {
 std::string fleet_metrics(const BoardInput& in, const EventHistory& events,
                           const std::deque<AckOutcome>& acks) {
   prometheus::Registry reg;
-  std::set<std::uint32_t> mmsis;
-  for (const auto& [key, row] : in.rows) mmsis.insert(key.first);
-  for (const auto& [m, st] : in.statuses) mmsis.insert(m);
-  for (const auto& [m, age] : in.heard_age) mmsis.insert(m);
-  for (const std::uint32_t m : in.roster_never_heard) mmsis.insert(m);
+  const std::set<std::uint32_t> mmsis = board_vessels(in);
 
   gauge(reg, "usv_fdi_fleet_vessels", "vessels on the board (heard, latched or on the roster)")
       .Add({})
