@@ -4,11 +4,15 @@
 // carried in the binary (dashboard/web/), the board as JSON (/api/board), the board pushed on
 // every change and once a second (server-sent events, /api/stream) and acknowledgements
 // (/api/ack, written as FaultAck by the DDS thread, their outcome shown on the board), and the
-// fleet's Prometheus metrics (/metrics, refreshed once a second).
+// fleet's Prometheus metrics (/metrics, refreshed once a second). With an accounts file every
+// request carries HTTP Basic credentials (operators acknowledge under their own name, observers
+// only look); with a certificate and key it serves HTTPS.
 //
 // Threads: the main thread owns DDS and the fleet view; the HTTP server's threads see only the
 // Hub (the latest board as text, and the queue of acknowledgements asked for).
 #include <spdlog/spdlog.h>
+#include <termios.h>
+#include <unistd.h>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
@@ -16,9 +20,13 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -29,6 +37,7 @@
 #include "ack_protocol.hpp"
 #include "commands.hpp"
 #include "credentials.hpp"
+#include "dashboard/accounts.hpp"
 #include "dashboard/board.hpp"
 #include "dashboard/metrics.hpp"
 #include "dashboard_assets.hpp"
@@ -50,6 +59,9 @@ struct DashboardArgs {
   std::string listen = "127.0.0.1:8080";
   bool read_only = false;
   std::size_t history = 1000;
+  std::string accounts;           ///< accounts file (dashboard/accounts.hpp); "" none: no sign-in
+  std::string tls_cert, tls_key;  ///< PEM files: HTTPS when both are given
+  bool tls() const { return !tls_cert.empty(); }
 };
 
 /// What the HTTP threads share with the DDS thread: the latest board and the acks asked for.
@@ -153,18 +165,35 @@ std::set<std::string> allowed_hosts(const std::string& host, int port) {
   return out;
 }
 
+/// Who asks: the account its credentials prove (with an accounts file), or the anonymous user
+/// of a dashboard without accounts (name ""; an operator unless the dashboard is read-only).
+std::optional<db::Account> requester(db::Authenticator* auth, const httplib::Request& req) {
+  if (auth == nullptr) return db::Account{"", db::Role::kOperator, ""};
+  return auth->check(req.get_header_value("Authorization"));
+}
+
 void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
-            const std::set<std::string>& hosts) {
+            const std::set<std::string>& hosts, db::Authenticator* auth) {
   svr.set_payload_max_length(4096);  // an ack request is a few dozen bytes
   svr.set_keep_alive_timeout(1);
-  svr.set_pre_routing_handler([hosts](const httplib::Request& req, httplib::Response& res) {
-    if (hosts.empty() || hosts.count(req.get_header_value("Host")) > 0) {
-      return httplib::Server::HandlerResponse::Unhandled;
+  svr.set_pre_routing_handler([hosts, auth](const httplib::Request& req, httplib::Response& res) {
+    if (!hosts.empty() && hosts.count(req.get_header_value("Host")) == 0) {
+      reply_json(res, 421,
+                 {{"error", "this dashboard does not serve the host '" +
+                                escape_text(req.get_header_value("Host")) + "'"}});
+      return httplib::Server::HandlerResponse::Handled;
     }
-    reply_json(res, 421,
-               {{"error", "this dashboard does not serve the host '" +
-                              escape_text(req.get_header_value("Host")) + "'"}});
-    return httplib::Server::HandlerResponse::Handled;
+    // With accounts, nothing (page, board, stream, metrics, acks) without valid credentials.
+    if (auth != nullptr && !requester(auth, req)) {
+      if (req.has_header("Authorization")) {
+        spdlog::warn("refused {} {} from {}: wrong name or password", req.method, req.path,
+                     req.remote_addr);
+      }
+      res.set_header("WWW-Authenticate", "Basic realm=\"usv-fdi dashboard\", charset=\"UTF-8\"");
+      reply_json(res, 401, {{"error", "sign in with a dashboard account"}});
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   const auto page = [](const char* body, const char* type) {
     return [body, type](const httplib::Request&, httplib::Response& res) {
@@ -182,6 +211,16 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
   svr.Get("/api/board", [&hub](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
     res.set_content(hub.current(), "application/json");
+  });
+  // Who the page's user is and whether they may acknowledge.
+  svr.Get("/api/me", [auth, &a](const httplib::Request& req, httplib::Response& res) {
+    const std::optional<db::Account> who = requester(auth, req);
+    const bool can_ack = who && who->role == db::Role::kOperator && !a.read_only;
+    res.set_header("Cache-Control", "no-cache");
+    reply_json(res, 200,
+               {{"name", who && !who->name.empty() ? json(who->name) : json(nullptr)},
+                {"role", can_ack ? "operator" : "observer"},
+                {"can_ack", can_ack}});
   });
   svr.Get("/metrics", [&hub](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
@@ -213,7 +252,7 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
         },
         [&hub](bool) { hub.close_stream(); });
   });
-  svr.Post("/api/ack", [&hub, &a](const httplib::Request& req, httplib::Response& res) {
+  svr.Post("/api/ack", [&hub, &a, auth](const httplib::Request& req, httplib::Response& res) {
     if (a.read_only) {
       reply_json(res, 403,
                  {{"error", "this dashboard is read-only (observers cannot acknowledge)"}});
@@ -221,10 +260,21 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
                    req.remote_addr);
       return;
     }
+    const std::optional<db::Account> who = requester(auth, req);
+    if (!who || who->role != db::Role::kOperator) {
+      const std::string name = who ? escape_text(who->name) : std::string("?");
+      reply_json(
+          res, 403,
+          {{"error", "the account '" + name + "' is an observer: observers cannot acknowledge"}});
+      spdlog::warn("refused an acknowledgement from {}: the account {} is an observer",
+                   req.remote_addr, name);
+      return;
+    }
     // JSON only (a cross-site form or a "simple" fetch cannot send it without the browser
     // asking first, and nothing here allows that), and from this dashboard's own page.
     const std::string origin = req.get_header_value("Origin");
-    if (!origin.empty() && origin != "http://" + req.get_header_value("Host")) {
+    const std::string scheme = a.tls() ? "https://" : "http://";
+    if (!origin.empty() && origin != scheme + req.get_header_value("Host")) {
       reply_json(res, 403, {{"error", "acknowledgements come from this dashboard's own page"}});
       spdlog::warn("refused an acknowledgement from {}: origin {}", req.remote_addr,
                    escape_text(origin));
@@ -236,7 +286,16 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
     }
     db::AckWork w;
     std::string why;
-    if (!db::parse_ack_body(req.body, &w, &why)) {
+    std::string body = req.body;
+    if (auth != nullptr) {
+      // Signed in: the acknowledgement is the account's, whatever name the body gives.
+      json j = json::parse(body, nullptr, false);
+      if (j.is_object()) {
+        j["operator"] = who->name;
+        body = j.dump();
+      }
+    }
+    if (!db::parse_ack_body(body, &w, &why)) {
       reply_json(res, 400, {{"error", why}});
       spdlog::warn("refused an acknowledgement request from {}: {}", req.remote_addr,
                    escape_text(why));
@@ -525,6 +584,41 @@ int run_dashboard(DashboardArgs& a) {
                   a.listen);
     return kExitUsage;
   }
+  if (a.tls_cert.empty() != a.tls_key.empty()) {
+    spdlog::error("--tls-cert and --tls-key go together (HTTPS needs the certificate and its key)");
+    return kExitUsage;
+  }
+  for (const std::string* f : {&a.tls_cert, &a.tls_key}) {
+    if (!f->empty() && !std::ifstream(*f).good()) {
+      spdlog::error("{} {}: cannot read it", f == &a.tls_cert ? "--tls-cert" : "--tls-key", *f);
+      return kExitUsage;
+    }
+  }
+  std::unique_ptr<db::Authenticator> auth;
+  if (!a.accounts.empty()) {
+    try {
+      auth = std::make_unique<db::Authenticator>(db::load_accounts(a.accounts));
+    } catch (const std::exception& e) {
+      spdlog::error("--accounts: {}", e.what());
+      return kExitUsage;
+    }
+    std::error_code ec;
+    const auto perms = std::filesystem::status(a.accounts, ec).permissions();
+    if (!ec && (perms & std::filesystem::perms::others_read) != std::filesystem::perms::none) {
+      spdlog::warn(
+          "--accounts {}: every user of this host may read the password hashes "
+          "(chmod 600)",
+          a.accounts);
+    }
+    const bool loopback = host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+    if (!a.tls() && !loopback) {
+      spdlog::error(
+          "--accounts on {} without --tls-cert/--tls-key: passwords would cross the network in "
+          "clear; give a certificate and key, or listen on a loopback address",
+          a.listen);
+      return kExitUsage;
+    }
+  }
   a.m.status = true;  // the board shows each vessel's detector status
   std::unique_ptr<dds::DdsContext> ctx;
   std::unique_ptr<FleetView> view;
@@ -544,7 +638,19 @@ int run_dashboard(DashboardArgs& a) {
     hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
   }
 
-  httplib::Server svr;
+  std::unique_ptr<httplib::Server> server;
+  if (a.tls()) {
+    auto ssl = std::make_unique<httplib::SSLServer>(a.tls_cert.c_str(), a.tls_key.c_str());
+    if (!ssl->is_valid()) {
+      spdlog::error("--tls-cert {} / --tls-key {}: not a PEM certificate and its private key",
+                    a.tls_cert, a.tls_key);
+      return kExitUsage;
+    }
+    server = std::move(ssl);
+  } else {
+    server = std::make_unique<httplib::Server>();
+  }
+  httplib::Server& svr = *server;
   svr.new_task_queue = [] { return new httplib::ThreadPool(Hub::kThreads); };
   const int bound =
       port == 0 ? svr.bind_to_any_port(host) : (svr.bind_to_port(host, port) ? port : -1);
@@ -553,15 +659,19 @@ int run_dashboard(DashboardArgs& a) {
                   a.listen);
     return kExitFailure;
   }
-  routes(svr, hub, a, allowed_hosts(host, bound));
+  routes(svr, hub, a, allowed_hosts(host, bound), auth.get());
   std::thread http([&svr] { svr.listen_after_bind(); });
   // svr.stop() does nothing before the server runs: wait for it (bounded) so that a stop joins.
   for (int i = 0; i < 500 && !svr.is_running(); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  spdlog::info("dashboard on http://{}:{}/ ({}; DDS domain {}): running",
+  spdlog::info("dashboard on {}://{}:{}/ ({}; {}; DDS domain {}): running",
+               a.tls() ? "https" : "http",
                host.find(':') != std::string::npos ? "[" + host + "]" : host, bound,
-               a.read_only ? "read-only" : "operators may acknowledge", ctx->config().domain_id);
+               a.read_only ? "read-only" : "operators may acknowledge",
+               auth ? std::to_string(auth->size()) + " account(s) from " + a.accounts
+                    : std::string("no sign-in"),
+               ctx->config().domain_id);
   try {
     rc = serve(a, *view, events, acks, hub, expiry);
   } catch (const std::exception& e) {
@@ -575,9 +685,105 @@ int run_dashboard(DashboardArgs& a) {
   return rc;
 }
 
+struct AccountArgs {
+  std::string name;
+  std::string role = "operator";
+  unsigned iterations = db::kDefaultIterations;
+  std::string file;  ///< append to this accounts file (made if missing) instead of printing
+};
+
+/// usv-fdi dashboard-account: reads a password (the first line of stdin; typed without echo on
+/// a terminal) and prints the account's entry for the accounts file, the password salted and
+/// hashed.
+int run_dashboard_account(const AccountArgs& a) {
+  if (const std::string why = db::check_account_name(a.name); !why.empty()) {
+    spdlog::error("account name '{}': {}", escape_text(a.name), why);
+    return kExitUsage;
+  }
+  bool fresh = true;  // the file is missing or empty: it starts with `accounts:`
+  if (!a.file.empty()) {
+    std::ifstream in(a.file);
+    fresh = !in.good() || in.peek() == std::ifstream::traits_type::eof();
+    if (!fresh) {
+      try {
+        if (db::load_accounts(a.file).count(a.name) > 0) {
+          spdlog::error("{} has an account '{}' already (remove its entry to set a new password)",
+                        a.file, escape_text(a.name));
+          return kExitUsage;
+        }
+      } catch (const std::exception& e) {
+        spdlog::error("{}", e.what());
+        return kExitUsage;
+      }
+    }
+  }
+  const bool tty = isatty(STDIN_FILENO) != 0;
+  termios saved{};
+  if (tty) {
+    std::cerr << "password for " << a.name << ": " << std::flush;
+    if (tcgetattr(STDIN_FILENO, &saved) == 0) {
+      termios quiet = saved;
+      quiet.c_lflag &= ~static_cast<tcflag_t>(ECHO);
+      tcsetattr(STDIN_FILENO, TCSAFLUSH, &quiet);
+    }
+  }
+  std::string password;
+  const bool got = static_cast<bool>(std::getline(std::cin, password));
+  if (tty) {
+    tcsetattr(STDIN_FILENO, TCSAFLUSH, &saved);
+    std::cerr << "\n";
+  }
+  if (!password.empty() && password.back() == '\r') password.pop_back();
+  if (!got || password.size() < 8) {
+    spdlog::error("the password (the first line of stdin) must have at least 8 characters");
+    return kExitUsage;
+  }
+  const db::Role role = a.role == "observer" ? db::Role::kObserver : db::Role::kOperator;
+  const std::string entry =
+      db::account_entry(a.name, role, db::hash_password(password, a.iterations));
+  if (a.file.empty()) {
+    std::cout << entry;
+    return kExitOk;
+  }
+  std::ofstream out(a.file, std::ios::app);
+  if (fresh && out) {
+    // The hashes are for the dashboard's eyes only: a new file is its owner's alone.
+    std::error_code ec;
+    std::filesystem::permissions(
+        a.file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write, ec);
+  }
+  out << (fresh ? "accounts:\n" : "") << entry;
+  out.flush();
+  if (!out) {
+    spdlog::error("cannot write {}", a.file);
+    return kExitFailure;
+  }
+  spdlog::info("{} account '{}' added to {}", to_string(role), escape_text(a.name), a.file);
+  return kExitOk;
+}
+
 }  // namespace
 
 void register_dashboard_command(CommandRegistry& registry) {
+  static AccountArgs account;
+  CLI::App* acc = registry.add(
+      "dashboard-account",
+      "print an account entry for `usv-fdi dashboard --accounts` (the password, read from stdin, "
+      "stored as a salted PBKDF2-SHA256 hash)",
+      [] { return run_dashboard_account(account); });
+  acc->add_option("name", account.name,
+                  "the account's name (what acknowledgements are signed with)")
+      ->required();
+  acc->add_option("--role", account.role, "operator (may acknowledge) or observer (read only)")
+      ->check(CLI::IsMember({"operator", "observer"}))
+      ->capture_default_str();
+  acc->add_option("--file", account.file,
+                  "append the entry to this accounts file (made if missing; a name already in it "
+                  "is refused) instead of printing it");
+  acc->add_option("--iterations", account.iterations, "PBKDF2 iterations")
+      ->check(CLI::Range(1000u, 100000000u))
+      ->capture_default_str();
+
   static DashboardArgs args;
   CLI::App* sub =
       registry.add("dashboard",
@@ -589,6 +795,15 @@ void register_dashboard_command(CommandRegistry& registry) {
       ->capture_default_str();
   sub->add_flag("--read-only", args.read_only,
                 "observers only: no acknowledge button, acknowledgements refused (403)");
+  sub->add_option("--accounts", args.accounts,
+                  "accounts file (YAML; entries from `usv-fdi dashboard-account`): every request "
+                  "must sign in (HTTP Basic); operators acknowledge under their name, observers "
+                  "only look")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--tls-cert", args.tls_cert, "PEM certificate (chain): serve HTTPS")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--tls-key", args.tls_key, "PEM private key of --tls-cert")
+      ->check(CLI::ExistingFile);
   sub->add_option("--mmsi", args.m.mmsi, "only these vessels (repeatable)")
       ->check(CLI::Range(1u, 999999999u));
   sub->add_option("--silent-after", args.m.silent_after,

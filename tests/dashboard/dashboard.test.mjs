@@ -7,9 +7,10 @@
 // screenshots).
 import { test, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
+import { spawn, spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
+import https from 'node:https';
 import path from 'node:path';
 import { chromium } from 'playwright-core';
 
@@ -69,14 +70,14 @@ async function launch() {
   });
   return browser;
 }
-async function newPage() {
-  const ctx = await (await launch()).newContext({ viewport: { width: 1400, height: 900 } });
+async function newPage(options = {}) {
+  const ctx = await (await launch()).newContext({ viewport: { width: 1400, height: 900 }, ...options });
   const page = await ctx.newPage();
   const errors = [];
   page.on('pageerror', (e) => errors.push(String(e)));
   // (the refusals the tests provoke on purpose, 400, 403 and 415, are logged by the browser too)
   page.on('console', (m) => {
-    if (m.type() === 'error' && !/status of (400|403|415)/.test(m.text())) errors.push(m.text());
+    if (m.type() === 'error' && !/status of (400|401|403|415)/.test(m.text())) errors.push(m.text());
   });
   page.errors = errors;
   return page;
@@ -89,7 +90,7 @@ function dds(partition) {
 async function dashboard(name, partition, extra = []) {
   const d = start(name, ['dashboard', ...dds(partition), '--listen', '127.0.0.1:0', ...extra]);
   await waitLog(d, ': running', 30);
-  const m = readLog(d).match(/dashboard on (http:\/\/127\.0\.0\.1:\d+\/)/);
+  const m = readLog(d).match(/dashboard on (https?:\/\/127\.0\.0\.1:\d+\/)/);
   assert.ok(m, readLog(d));
   d.url = m[1];
   return d;
@@ -246,4 +247,110 @@ test('a board of 100 emulated vessels loads and stays responsive', async () => {
   assert.ok(probe < 2000, `a frame took ${probe} ms`);
   await page.screenshot({ path: path.join(out, 'board100.png') });
   assert.deepEqual(page.errors, [], 'no script errors');
+});
+
+test('signed in over HTTPS: operators acknowledge under their own name, observers only look', async () => {
+  const mmsi = 257000072;
+  const part = `usv_fdi_dash_${process.pid}_c`;
+  // A self-signed certificate for 127.0.0.1, and two accounts made with usv-fdi dashboard-account.
+  const cert = path.join(out, 'tls_cert.pem'), key = path.join(out, 'tls_key.pem');
+  const accounts = path.join(out, 'accounts.yaml');
+  const tool = (cmd, args, input) => {
+    const r = spawnSync(cmd, args, { input, encoding: 'utf8' });
+    assert.equal(r.status, 0, `${cmd} ${args.join(' ')}: ${r.stderr}`);
+    return r;
+  };
+  tool('openssl', ['req', '-x509', '-newkey', 'ec', '-pkeyopt', 'ec_paramgen_curve:P-256', '-nodes',
+                   '-keyout', key, '-out', cert, '-days', '2', '-subj', '/CN=127.0.0.1',
+                   '-addext', 'subjectAltName=IP:127.0.0.1']);
+  fs.rmSync(accounts, { force: true });
+  tool(exe, ['dashboard-account', 'carol', '--role', 'operator', '--file', accounts], 'correct horse battery\n');
+  tool(exe, ['dashboard-account', 'dave', '--role', 'observer', '--file', accounts], 'staple: paper clip\n');
+  assert.equal(fs.statSync(accounts).mode & 0o777, 0o600);
+  assert.ok(!fs.readFileSync(accounts, 'utf8').includes('correct horse'), 'no password in clear');
+
+  const svc = start('sidecar_tls', ['run', '--config', paper, '--mmsi', String(mmsi), '--reliable-inputs',
+                                    ...dds(part)]);
+  await waitLog(svc, 'waiting for INS and rudder');
+  const dash = await dashboard('dashboard_tls', part, ['--accounts', accounts, '--tls-cert', cert,
+                                                       '--tls-key', key]);
+  assert.match(dash.url, /^https:/);
+  // Without credentials, or with a wrong password, nothing is served (verified TLS: our own CA).
+  const get = (p, auth) => new Promise((resolve, reject) => {
+    const u = new URL(p, dash.url);
+    https.get({ host: u.hostname, port: u.port, path: u.pathname, ca: fs.readFileSync(cert),
+                headers: auth ? { Authorization: 'Basic ' + Buffer.from(auth).toString('base64') } : {} },
+              (r) => { let b = ''; r.on('data', (c) => { b += c; });
+                       r.on('end', () => resolve({ status: r.statusCode, headers: r.headers, body: b })); })
+      .on('error', reject);
+  });
+  for (const p of ['/', '/api/board', '/api/stream', '/metrics']) {
+    const r = await get(p);
+    assert.equal(r.status, 401, `${p} without credentials`);
+    assert.match(r.headers['www-authenticate'], /^Basic realm="usv-fdi dashboard"/);
+  }
+  assert.equal((await get('/api/board', 'carol:correct horse')).status, 401, 'a wrong password');
+  assert.equal((await get('/api/board', 'mallory:correct horse battery')).status, 401, 'no such account');
+  const scraped = await get('/metrics', 'dave:staple: paper clip');
+  assert.equal(scraped.status, 200);
+  assert.match(scraped.body, /^usv_fdi_fleet_vessels /m);
+  // Plain HTTP on the HTTPS port gets no page.
+  const plain = await new Promise((resolve) => {
+    http.get(dash.url.replace('https:', 'http:') + 'api/board', (r) => { r.resume(); resolve(r.statusCode); })
+      .on('error', () => resolve('refused'));
+  });
+  assert.notEqual(plain, 200);
+
+  const operator = await newPage({ httpCredentials: { username: 'carol', password: 'correct horse battery' },
+                                   ignoreHTTPSErrors: true });
+  const observer = await newPage({ httpCredentials: { username: 'dave', password: 'staple: paper clip' },
+                                   ignoreHTTPSErrors: true });
+  for (const p of [operator, observer]) {
+    await p.goto(dash.url);
+    await p.waitForSelector(`tr[data-mmsi="${mmsi}"]`, { timeout: 30000 });
+  }
+  assert.equal(await operator.textContent('#account'), 'signed in as carol (operator)');
+  assert.equal(await observer.textContent('#account'), 'signed in as dave (observer)');
+  assert.equal(await operator.isVisible('#operator'), false, 'no name to type when signed in');
+  assert.equal(await operator.textContent('#link'), 'live');
+  assert.equal(await observer.textContent('#link'), 'live');
+
+  const sim = start('sim_tls', ['sim', '--publish', '--mmsi', String(mmsi), '--vessel', 'otter',
+                                '--scenario', 'paper', '--noise-scale', '0', '--speed', '4',
+                                '--reliable', '--linger', '0.5', ...dds(part)]);
+  // (the rectified, unacknowledged state: it waits for an acknowledgement and does not move on)
+  const raised = `${cell(mmsi, 'gyro')}[data-state="cleared"]`;
+  await operator.waitForSelector(raised, { timeout: 90000 });
+  await operator.waitForSelector(`button.ack[data-mmsi="${mmsi}"][data-sensor="gyro"]`, { timeout: 10000 });
+  await observer.waitForSelector(raised, { timeout: 30000 });
+  // The observer sees the raise but has no button, and a forged request is refused.
+  assert.equal(await observer.$$eval('button.ack', (b) => b.length), 0);
+  const forged = await observer.evaluate(async ([m, seq]) => {
+    const r = await fetch('/api/ack', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify({ mmsi: m, sensor: 'gyro', sequence: seq, operator: 'carol' }) });
+    return [r.status, (await r.json()).error];
+  }, [mmsi, Number(await observer.getAttribute(raised, 'data-sequence'))]);
+  assert.equal(forged[0], 403);
+  assert.match(forged[1], /'dave' is an observer/);
+  // The operator's button acknowledges under the account's name.
+  await operator.click(`button.ack[data-mmsi="${mmsi}"][data-sensor="gyro"]`);
+  await operator.waitForSelector('#acks tbody tr[data-sensor="gyro"][data-state="accepted"]', { timeout: 30000 });
+  await waitLog(svc, 'acknowledged by carol', 10);
+  // A name in the body does not override the account's.
+  const accel = `${cell(mmsi, 'accelerometer')}[data-state="cleared"]`;
+  await operator.waitForSelector(accel, { timeout: 90000 });
+  const named = await operator.evaluate(async ([m, seq]) => {
+    const r = await fetch('/api/ack', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify({ mmsi: m, sensor: 'accelerometer', sequence: seq, operator: 'mallory' }) });
+    return r.status;
+  }, [mmsi, Number(await operator.getAttribute(accel, 'data-sequence'))]);
+  assert.equal(named, 202);
+  await operator.waitForSelector('#acks tbody tr[data-sensor="accelerometer"][data-state="accepted"]', { timeout: 30000 });
+  assert.match(readLog(svc), /accelerometer #\d+ \w+ .*acknowledged by carol/);
+  assert.ok(!readLog(svc).includes('mallory'), 'the body\'s name was not used');
+  assert.equal(await sim.exited, 0, readLog(sim));
+  assert.ok(!readLog(svc).includes('dave'), 'the sidecar never saw the observer\'s request');
+  await operator.screenshot({ path: path.join(out, 'board_signed_in.png') });
+  assert.deepEqual(operator.errors, [], 'no script errors (operator)');
+  assert.deepEqual(observer.errors, [], 'no script errors (observer)');
 });

@@ -11,6 +11,7 @@ const STATE_WORDS = {
   'normal': 'normal',
 };
 let board = null;
+let me = { name: null, role: 'observer', can_ack: false };  // /api/me: the signed-in account
 const sent = new Set();  // mmsi/sensor/sequence acknowledged from this page
 let holding = false;     // a pointer is down: the board waits, so that a click is not lost
 let stale = false;       // a board arrived while holding
@@ -58,7 +59,7 @@ function sensorCell(v, sensor) {
     `${r.kind} · C_a ${fixed(r.c_a, 2)} · C_g ${fixed(r.c_g, 2)} · #${r.sequence} · ${age(r.age_s)} ago`));
   if (!r.alive) cell.append(el('div', { class: 'detail' }, 'sidecar gone: last known state'));
   const ackable = r.state === 'raised' || r.state === 'cleared';
-  if (ackable && board.can_ack) {
+  if (ackable && board.can_ack && me.can_ack) {
     const b = el('button', { class: 'ack', 'data-mmsi': v.mmsi, 'data-sensor': sensor,
                              'data-sequence': r.sequence }, 'Acknowledge #' + r.sequence);
     b.disabled = sent.has(`${v.mmsi}/${sensor}/${r.sequence}`);
@@ -134,7 +135,11 @@ function renderAcks() {
 }
 
 function render() {
-  document.getElementById('operator-box').hidden = !board.can_ack;
+  // Signed in: acknowledgements carry the account's name; otherwise the operator types it.
+  document.getElementById('operator-box').hidden = !(board.can_ack && me.can_ack) || !!me.name;
+  const account = document.getElementById('account');
+  account.hidden = !me.name;
+  account.textContent = me.name ? `signed in as ${me.name} (${me.role})` : '';
   renderBoard();
   renderEvents();
   renderAcks();
@@ -142,13 +147,13 @@ function render() {
 
 async function acknowledge(mmsi, sensor, sequence, button) {
   const out = document.getElementById('ack-result');
-  const operator = document.getElementById('operator').value.trim();
+  const operator = me.name || document.getElementById('operator').value.trim();
   if (!operator) {
     out.textContent = 'Give your name (Operator) before acknowledging.';
     out.className = 'refused';
     return;
   }
-  localStorage.setItem('usv-fdi-operator', operator);
+  if (!me.name) localStorage.setItem('usv-fdi-operator', operator);
   const key = `${mmsi}/${sensor}/${sequence}`;
   if (sent.has(key)) return;
   sent.add(key);
@@ -185,4 +190,7 @@ document.addEventListener('pointerup', () => {
   setTimeout(() => { if (stale && !holding) { stale = false; render(); } }, 0);
 });
 document.getElementById('operator').value = localStorage.getItem('usv-fdi-operator') || '';
-connect();
+fetch('/api/me').then((r) => (r.ok ? r.json() : null)).then((m) => {
+  if (m) me = m;
+  if (board) render();
+}).catch(() => {}).finally(connect);
