@@ -337,6 +337,7 @@ class Acks {
  public:
   static constexpr std::size_t kMaxPending = 100;
   static constexpr double kWatch = 60.0;  ///< [s] an unconfirmed ack is still watched this long
+  static constexpr double kMatchSettle = 1.0;  ///< [s] a new writer's first ack waits this long
 
   Acks(dds::DdsContext& ctx, FleetView& view, const MonitorArgs& a)
       : ctx_(ctx), view_(view), a_(a) {}
@@ -382,10 +383,10 @@ class Acks {
           r.ev.sequence <= req.sequence || p.state == "done") {
         continue;
       }
-      const std::string by = "acknowledged by " + escape_text(p.work.operator_id);
       const bool acked =
           r.ev.state == FaultState::kActiveAcknowledged || r.ev.state == FaultState::kAcknowledged;
-      if (r.ev.sequence == req.sequence + 1 && acked && r.ev.message == by) {
+      if (r.ev.sequence == req.sequence + 1 && acked &&
+          db::acknowledged_by(r.ev.message, escape_text(p.work.operator_id))) {
         settle(p.id, "accepted", "");
       } else if (r.ev.sequence == req.sequence + 1) {
         settle(p.id, "refused",
@@ -456,6 +457,7 @@ class Acks {
       fdds::PublicationMatchedStatus st;
       if (w != nullptr) w->get_publication_matched_status(st);
       if (row == nullptr || w == nullptr || st.current_count == 0) {
+        matched_at_.erase(req.mmsi);  // a sidecar matched again later waits again
         if (now - p->asked < a_.discovery_timeout && (row == nullptr || w != nullptr)) return;
         settle(p->id, "refused",
                row == nullptr ? "no latched event of this vessel and sensor is known here"
@@ -465,6 +467,11 @@ class Acks {
         *changed = true;
         return;
       }
+      // The writer matched the sidecar's reader; the sidecar may not have matched the writer yet
+      // (its side of discovery, under DDS Security its side of the handshake, comes later), and a
+      // volatile ack written before that is lost: a new writer waits kMatchSettle first.
+      const auto m = matched_at_.emplace(req.mmsi, now).first;
+      if (now - m->second < kMatchSettle) return;
       if (ack_already_past(req, row)) {
         settle(p->id, "refused", refusal_reason(req, row));
         p->state = "done";
@@ -512,6 +519,7 @@ class Acks {
   FleetView& view_;
   const MonitorArgs& a_;
   std::map<std::uint32_t, fdds::DataWriter*> writers_;
+  std::map<std::uint32_t, double> matched_at_;  ///< when a vessel's writer first matched [mono s]
   std::vector<Pending> pending_;
   std::deque<std::pair<std::uint64_t, db::AckOutcome>> outcomes_;
   std::uint64_t next_id_ = 0;

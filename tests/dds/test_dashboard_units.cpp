@@ -160,6 +160,17 @@ TEST(DashboardBoard, APeersTextIsEscapedSoTheBoardIsAlwaysValidJson) {
   EXPECT_EQ(text.find('\x1b'), std::string::npos);
 }
 
+TEST(DashboardBoard, TheSidecarsRecordOfAnAckNamesTheOperatorWithOrWithoutItsIdentity) {
+  EXPECT_TRUE(acknowledged_by("acknowledged by carol", "carol"));
+  // under DDS Security: the writer's authenticated CN, then the name it claimed
+  EXPECT_TRUE(acknowledged_by("acknowledged by dashboard:carol", "carol"));
+  EXPECT_FALSE(acknowledged_by("acknowledged by dashboard:carola", "carol"));
+  EXPECT_FALSE(acknowledged_by("acknowledged by carola", "carol"));
+  EXPECT_FALSE(acknowledged_by("acknowledged by :carol", "carol"));
+  EXPECT_FALSE(acknowledged_by("acknowledged by dashboard:carol", ""));
+  EXPECT_FALSE(acknowledged_by("residual back below 3.0", "carol"));
+}
+
 TEST(DashboardBoard, AnAckRequestIsCheckedFieldByField) {
   AckWork w;
   std::string why;

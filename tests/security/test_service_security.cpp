@@ -21,6 +21,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -28,8 +29,13 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "monitor_log.hpp"
 #include "process.hpp"
+
+// Last: it includes <resolv.h>, whose macros break headers included after it.
+#include <httplib.h>
 
 namespace usvfdi::security::test {
 namespace {
@@ -84,7 +90,8 @@ class PkiEnvironment : public ::testing::Environment {
              {(g_pki / "fleet").string(), "--partition-prefix", prefix, "--identity",
               "vessel:vessel:" + kM, "--identity", "sensors:sensors:" + kM, "--identity",
               "vessel:vessel2:" + kO, "--identity", "shore:shore:" + kM, "--identity",
-              "shore:shore2:" + kO, "--identity", "observer:observer"},
+              "shore:shore2:" + kO, "--identity", "observer:observer", "--identity",
+              "shore:dashboard:" + kM},
              {(g_pki / "foreign").string(), "--partition-prefix", prefix, "--ca-name", "foreign CA",
               "--identity", "shore:shore:*", "--identity", "sensors:sensors:" + kM}}) {
       std::vector<std::string> argv = {USV_FDI_MAKE_SECURITY};
@@ -146,7 +153,8 @@ class ServiceSecurity : public ::testing::Test {
   /// `vessel`: the vessel partition of a non-monitor process (default: kMmsi's).
   ChildProcess& start(const std::string& name, const Identity& id, std::vector<std::string> args,
                       const std::string& vessel = kM) {
-    const std::string partition = partition_ + (args.at(0) == "monitor" ? "*" : vessel);
+    const bool shore = args.at(0) == "monitor" || args.at(0) == "dashboard";
+    const std::string partition = partition_ + (shore ? "*" : vessel);
     std::vector<std::string> argv = {kExe};
     argv.insert(argv.end(), args.begin(), args.end());
     argv.insert(argv.end(),
@@ -377,6 +385,101 @@ TEST_F(ServiceSecurity, ReadOnlyObserverReadsButCannotAcknowledge) {
                       &attempts),
             0)
       << log("ack1") << log("sidecar");
+  stop_sidecar();
+}
+
+/// The HTTP port a dashboard logged ("dashboard on http://127.0.0.1:PORT/"), 0 if none yet.
+int dashboard_port(const std::string& log) {
+  const std::string tag = "dashboard on http://127.0.0.1:";
+  const std::size_t at = log.find(tag);
+  return at == std::string::npos ? 0 : std::atoi(log.c_str() + at + tag.size());
+}
+
+TEST_F(ServiceSecurity, TheDashboardActsUnderItsOwnIdentity) {
+  // GIVEN the secured sidecar, a dashboard with its own shore identity ("dashboard", granted this
+  // vessel) and one with the observer's identity
+  start_sidecar();
+  start("dashboard", fleet_id("dashboard"), {"dashboard", "--listen", "127.0.0.1:0"});
+  start("dashboard_observer", fleet_id("observer"),
+        {"dashboard", "--listen", "127.0.0.1:0", "--discovery-timeout", "5"});
+  for (const char* d : {"dashboard", "dashboard_observer"}) {
+    ASSERT_TRUE(wait_for_log(d, ": running", seconds(30))) << log(d);
+  }
+  ASSERT_TRUE(wait_for_log("sidecar", "2 fault-event reader(s)", seconds(30))) << log("sidecar");
+  // WHEN the authorised sensor gateway publishes the voyage
+  run_voyage();
+  std::map<std::string, SidecarEvent> own;
+  for (const SidecarEvent& e : sidecar_events(log("sidecar"))) own[e.sensor] = e;
+  ASSERT_FALSE(own.empty()) << pacing() << log("sidecar");
+  const std::string target = own.count("gyro") ? "gyro" : "accelerometer";
+  const std::uint64_t seq = own[target].sequence;
+  httplib::Client op("127.0.0.1", dashboard_port(log("dashboard")));
+  httplib::Client ob("127.0.0.1", dashboard_port(log("dashboard_observer")));
+  const auto board = [](httplib::Client& c) {
+    const auto r = c.Get("/api/board");
+    return r && r->status == 200 ? nlohmann::json::parse(r->body, nullptr, false)
+                                 : nlohmann::json();
+  };
+  const auto shown_sequence = [&](httplib::Client& c) -> std::uint64_t {
+    const nlohmann::json b = board(c);
+    if (!b.is_object()) return 0;
+    for (const auto& v : b["vessels"]) {
+      if (v.value("mmsi", 0u) == kMmsi && v["sensors"].contains(target)) {
+        return v["sensors"][target].value("sequence", std::uint64_t{0});
+      }
+    }
+    return 0;
+  };
+  const auto ack_state = [&](httplib::Client& c) -> std::string {
+    const nlohmann::json b = board(c);
+    if (!b.is_object() || b["acks"].empty()) return "";
+    return b["acks"][0].value("state", "");  // newest first
+  };
+  const auto within = [](seconds limit, const std::function<bool()>& f) {
+    const auto end = Clock::now() + limit;
+    while (!f()) {
+      if (Clock::now() > end) return false;
+      std::this_thread::sleep_for(milliseconds(100));
+    }
+    return true;
+  };
+  // THEN both dashboards show the sidecar's event (decrypted)
+  for (httplib::Client* c : {&op, &ob}) {
+    EXPECT_TRUE(within(seconds(15), [&] { return shown_sequence(*c) == seq; }))
+        << board(*c).dump() << log("dashboard") << log("dashboard_observer");
+  }
+  const std::string body = "{\"mmsi\": " + kM + ", \"sensor\": \"" + target +
+                           "\", \"sequence\": " + std::to_string(seq) + ", \"operator\": ";
+  // WHEN the observer identity's dashboard is asked to acknowledge it
+  const auto refused = ob.Post("/api/ack", body + "\"olive\"}", "application/json");
+  ASSERT_TRUE(refused);
+  // THEN access control refuses it the ack writer: the dashboard says so, the sidecar sees nothing
+  EXPECT_TRUE(within(seconds(20), [&] { return ack_state(ob) == "refused"; }))
+      << board(ob).dump() << log("dashboard_observer");
+  EXPECT_NE(log("dashboard_observer").find("is this identity granted the vessel?"),
+            std::string::npos)
+      << log("dashboard_observer");
+  // WHEN an operator acknowledges it on the shore identity's dashboard
+  std::string state;
+  int attempts = 0;
+  for (attempts = 1; attempts <= 3; ++attempts) {
+    const auto asked = op.Post("/api/ack", body + "\"carol\"}", "application/json");
+    ASSERT_TRUE(asked);
+    ASSERT_EQ(asked->status, 202) << asked->body;
+    within(seconds(20), [&] {
+      state = ack_state(op);
+      return state != "" && state != "pending";
+    });
+    if (state != "unconfirmed") break;  // (a lost first ack: asked again, as an operator would)
+  }
+  // THEN the sidecar takes it as the dashboard identity's operator, and the dashboard says so
+  EXPECT_EQ(state, "accepted") << board(op).dump() << log("dashboard") << log("sidecar");
+  std::printf("dashboard ack accepted after %d attempt(s)\n", attempts);
+  EXPECT_NE(log("sidecar").find("ack of " + target + " #" + std::to_string(seq) +
+                                " by dashboard:carol accepted"),
+            std::string::npos)
+      << log("sidecar");
+  EXPECT_EQ(log("sidecar").find("olive"), std::string::npos) << log("sidecar");
   stop_sidecar();
 }
 

@@ -195,4 +195,14 @@ json board_json(const BoardInput& in, const EventHistory& events,
       {"vessels", vessels}, {"events", events.to_json(now)},        {"acks", ack_list}};
 }
 
+bool acknowledged_by(const std::string& message, const std::string& operator_id) {
+  static const std::string kBy = "acknowledged by ";
+  if (message.rfind(kBy, 0) != 0 || operator_id.empty()) return false;
+  const std::string who = message.substr(kBy.size());
+  if (who == operator_id) return true;
+  // <CN>:<operator>, the CN without ':' (the sidecar writes the CN alone when it equals the name)
+  const std::size_t colon = who.find(':');
+  return colon != std::string::npos && colon > 0 && who.substr(colon + 1) == operator_id;
+}
+
 }  // namespace usvfdi::app::dashboard

@@ -62,6 +62,11 @@ struct AckWork {
 /// field that is wrong) if it is not one.
 bool parse_ack_body(const std::string& body, AckWork* out, std::string* why);
 
+/// True if an event's message is the sidecar's record of an acknowledgement by `operator_id`:
+/// "acknowledged by <operator>", or under DDS Security "acknowledged by <CN>:<operator>" (the
+/// sidecar names the writer's authenticated identity, then the name it claimed; both escaped).
+bool acknowledged_by(const std::string& message, const std::string& operator_id);
+
 /// What became of an acknowledgement sent from the dashboard.
 struct AckOutcome {
   std::uint32_t mmsi = 0;
