@@ -19,8 +19,13 @@ tests="${USV_FDI_TESTS:-OFF}"
 case "$tests" in ON | OFF) ;; *) echo "docker/build.sh: USV_FDI_TESTS must be ON or OFF" >&2; exit 2 ;; esac
 
 if [ "$tests" = ON ]; then "$src/scripts/install-deps.sh" --only test; fi
+# The dashboard's chart library comes from npm at build time ([web] in scripts/packages.txt);
+# the image's build stage has no npm unless the tests brought it: a vessel page without charts.
+charts=OFF
+if command -v npm > /dev/null 2>&1; then charts=ON; fi
 cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DUSV_FDI_WITH_DDS=ON -DUSV_FDI_BUILD_TESTS="$tests" -DUSV_FDI_BUILD_BENCH=OFF
+  -DUSV_FDI_WITH_DDS=ON -DUSV_FDI_BUILD_TESTS="$tests" -DUSV_FDI_BUILD_BENCH=OFF \
+  -DUSV_FDI_DASHBOARD_CHARTS="$charts"
 if [ "$tests" = ON ]; then
   cmake --build "$build" -j "$(nproc)"
   ctest --test-dir "$build" --output-on-failure -j "$(nproc)" --timeout 1500

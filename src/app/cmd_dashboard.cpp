@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <filesystem>
@@ -40,7 +41,9 @@
 #include "dashboard/accounts.hpp"
 #include "dashboard/board.hpp"
 #include "dashboard/metrics.hpp"
+#include "dashboard/vessel_history.hpp"
 #include "dashboard_assets.hpp"
+#include "dashboard_vendor.hpp"
 #include "dds_options.hpp"
 #include "fleet_view.hpp"
 #include "usv_fdi/core/text.hpp"
@@ -59,8 +62,9 @@ struct DashboardArgs {
   std::string listen = "127.0.0.1:8080";
   bool read_only = false;
   std::size_t history = 1000;
-  std::string accounts;           ///< accounts file (dashboard/accounts.hpp); "" none: no sign-in
-  std::string tls_cert, tls_key;  ///< PEM files: HTTPS when both are given
+  std::size_t chart_points = 300;  ///< statuses kept per vessel for its page's charts
+  std::string accounts;            ///< accounts file (dashboard/accounts.hpp); "" none: no sign-in
+  std::string tls_cert, tls_key;   ///< PEM files: HTTPS when both are given
   bool tls() const { return !tls_cert.empty(); }
 };
 
@@ -173,7 +177,8 @@ std::optional<db::Account> requester(db::Authenticator* auth, const httplib::Req
 }
 
 void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
-            const std::set<std::string>& hosts, db::Authenticator* auth) {
+            const std::set<std::string>& hosts, db::Authenticator* auth,
+            const db::VesselHistory& curves) {
   svr.set_payload_max_length(4096);  // an ack request is a few dozen bytes
   svr.set_keep_alive_timeout(1);
   svr.set_pre_routing_handler([hosts, auth](const httplib::Request& req, httplib::Response& res) {
@@ -206,6 +211,47 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
   svr.Get("/index.html", page(db::assets::kIndexHtml, "text/html; charset=utf-8"));
   svr.Get("/app.js", page(db::assets::kAppJs, "text/javascript; charset=utf-8"));
   svr.Get("/style.css", page(db::assets::kStyleCss, "text/css; charset=utf-8"));
+  svr.Get("/vessel.html", page(db::assets::kVesselHtml, "text/html; charset=utf-8"));
+  svr.Get("/vessel.js", page(db::assets::kVesselJs, "text/javascript; charset=utf-8"));
+  if (db::vendor::kHaveCharts) {
+    svr.Get("/uplot.js", page(db::vendor::kUplotJs, "text/javascript; charset=utf-8"));
+    svr.Get("/uplot.css", page(db::vendor::kUplotCss, "text/css; charset=utf-8"));
+  }
+  // A vessel's curves: its statuses later than `since` [s, the source time of a status].
+  svr.Get("/api/vessel", [&curves](const httplib::Request& req, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-cache");
+    std::uint32_t mmsi = 0;
+    double since = 0.0;
+    try {
+      std::size_t used = 0;
+      const std::string m = req.get_param_value("mmsi");
+      const unsigned long v = std::stoul(m, &used);
+      if (used != m.size() || m[0] == '-' || v < 1 || v > 999999999) throw std::out_of_range(m);
+      mmsi = static_cast<std::uint32_t>(v);
+    } catch (const std::exception&) {
+      reply_json(res, 400, {{"error", "mmsi: a vessel's MMSI (1 to 999999999) is required"}});
+      return;
+    }
+    if (req.has_param("since")) {
+      try {
+        std::size_t used = 0;
+        const std::string t = req.get_param_value("since");
+        since = std::stod(t, &used);
+        if (used != t.size() || !std::isfinite(since)) throw std::invalid_argument(t);
+      } catch (const std::exception&) {
+        reply_json(res, 400, {{"error", "since: a time in seconds (the last point's t)"}});
+        return;
+      }
+    }
+    json j;
+    if (!curves.to_json(mmsi, since, &j)) {
+      reply_json(res, 404,
+                 {{"error", "no status of vessel " + std::to_string(mmsi) +
+                                " has reached this dashboard yet"}});
+      return;
+    }
+    reply_json(res, 200, j);
+  });
   svr.Get("/favicon.ico",
           [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
   svr.Get("/api/board", [&hub](const httplib::Request&, httplib::Response& res) {
@@ -635,6 +681,8 @@ int run_dashboard(DashboardArgs& a) {
   if (rc != kExitOk) return rc;
   db::EventHistory events(a.history);
   Acks acks(*ctx, *view, a.m);
+  db::VesselHistory curves(a.chart_points);
+  view->on_status([&curves](const VesselStatus& v) { curves.add(v); });
   view->on_row([&events, &acks](const Row& r) {
     events.add(r);
     acks.on_event(r);
@@ -667,7 +715,7 @@ int run_dashboard(DashboardArgs& a) {
                   a.listen);
     return kExitFailure;
   }
-  routes(svr, hub, a, allowed_hosts(host, bound), auth.get());
+  routes(svr, hub, a, allowed_hosts(host, bound), auth.get(), curves);
   std::thread http([&svr] { svr.listen_after_bind(); });
   // svr.stop() does nothing before the server runs: wait for it (bounded) so that a stop joins.
   for (int i = 0; i < 500 && !svr.is_running(); ++i) {
@@ -823,6 +871,10 @@ void register_dashboard_command(CommandRegistry& registry) {
       ->check(CLI::ExistingFile);
   sub->add_option("--history", args.history, "events kept in the event list")
       ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  sub->add_option("--chart-points", args.chart_points,
+                  "statuses kept per vessel for the curves of its page")
+      ->check(CLI::Range(10, 100000))
       ->capture_default_str();
   sub->add_option("--ack-timeout", args.m.ack_timeout,
                   "wait this long for the sidecar's confirmation of an acknowledgement [s]")

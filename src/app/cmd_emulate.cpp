@@ -14,6 +14,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -94,6 +95,17 @@ class Fleet {
     s.rudder_healthy(true);
     s.samples(v.samples += 10);
     s.incarnation(1);
+    // Residual statistics as a sidecar's: healthy near 1, a raised channel's above its threshold.
+    std::array<double, 2> j{};
+    for (std::size_t c = 0; c < 2; ++c) {
+      const double wave = 1.2 + 0.4 * std::sin(0.3 * static_cast<double>(v.samples) + c);
+      j[c] = v.raised[c] ? 4.0 * wave + 5.0 : wave;
+    }
+    s.j_peak(j);
+    s.j_raise({6.0, 6.0});
+    s.j_leave({3.0, 3.0});
+    s.c_a(v.raised[0] ? 0.97 : 0.05);
+    s.c_g(v.raised[1] ? 0.98 : 0.04);
     s.message("emulated");
     dds::write(*parts_[static_cast<std::size_t>(v.participant)].status, s);
     ++statuses_;

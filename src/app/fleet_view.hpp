@@ -185,6 +185,7 @@ class FleetView {
             vessels_.offer(st.mmsi(), st.mmsi(), writer_ref(info.publication_handle), 0, v);
         if (dec.report) report(dec, st.mmsi(), "status", info.publication_handle, 0, "");
         if (dec.verdict != OwnerDecision::Verdict::kShown) continue;
+        if (on_status_) on_status_(v);
         if (a_.json && a_.status) {
           std::printf("%s\n", json_status(v, live_.age(st.mmsi(), mono_now()), wall_now()).c_str());
           std::fflush(stdout);
@@ -204,6 +205,8 @@ class FleetView {
 
   /// Calls `f` with every fault event shown (after the ownership check), as it is applied.
   void on_row(std::function<void(const Row&)> f) { on_row_ = std::move(f); }
+  /// Called with every status shown (its writer owns the vessel's status instance).
+  void on_status(std::function<void(const VesselStatus&)> f) { on_status_ = std::move(f); }
 
   /// --once: true when the latched state has arrived (LatchedStateWait).
   bool latched_complete() const {
@@ -407,6 +410,7 @@ class FleetView {
   int discovery_warned_ = 0;  ///< discovery_limit_level() already warned about
   int conflicts_ = 0;
   std::function<void(const Row&)> on_row_;
+  std::function<void(const VesselStatus&)> on_status_;
 };
 
 /// Joins the DDS domain with a fleet view's readers (the roster of a.roster) and reads the

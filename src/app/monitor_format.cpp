@@ -55,7 +55,13 @@ std::string json_status(const VesselStatus& v, double heard_age, double now) {
      << ",\"excitation\":" << io::json_number(s.excitation())
      << ",\"surge_speed\":" << io::json_number(s.surge_speed())
      << ",\"speed_ratio\":" << io::json_number(s.speed_ratio())
-     << ",\"reference_speed\":" << io::json_number(s.reference_speed())
+     << ",\"reference_speed\":" << io::json_number(s.reference_speed()) << ",\"j_peak\":["
+     << io::json_number(s.j_peak()[0]) << "," << io::json_number(s.j_peak()[1]) << "],\"j_raise\":["
+     << io::json_number(s.j_raise()[0]) << "," << io::json_number(s.j_raise()[1])
+     << "],\"j_leave\":[" << io::json_number(s.j_leave()[0]) << ","
+     << io::json_number(s.j_leave()[1]) << "],\"c_a\":" << io::json_number(s.c_a())
+     << ",\"c_g\":" << io::json_number(s.c_g())
+     << ",\"model_mismatch\":" << (s.model_mismatch() ? "true" : "false")
      << ",\"ins_healthy\":" << (s.ins_healthy() ? "true" : "false")
      << ",\"rudder_healthy\":" << (s.rudder_healthy() ? "true" : "false")
      << ",\"samples\":" << s.samples() << ",\"dropped\":" << s.dropped()

@@ -109,6 +109,12 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
   d.surge_speed(s.surge_speed);
   d.speed_ratio(s.estimate.speed_ratio);
   d.reference_speed(s.estimate.reference_speed);
+  d.j_peak({s.j_peak[0], s.j_peak[1]});
+  d.j_raise({s.j_raise[0], s.j_raise[1]});
+  d.j_leave({s.j_leave[0], s.j_leave[1]});
+  d.c_a(s.isolation.c_a);
+  d.c_g(s.isolation.c_g);
+  d.model_mismatch(s.isolation.model_mismatch);
   std::string msg;
   // First, so that the 128 characters keep it: the residuals contradict the model.
   if (s.isolation.model_mismatch) {

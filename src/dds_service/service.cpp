@@ -213,7 +213,18 @@ FdiService::FdiService(const ServiceConfig& cfg, LogSink log)
     }
     const double now =
         std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-    if (uplink_.offer(d, now) != UplinkReason::kNone) dds::write(*status_writer_, d);
+    // A status not sent hands its J_N peaks on to the next one, so the shore sees every peak.
+    std::array<double, 2> peak = d.j_peak();
+    for (std::size_t c = 0; c < 2; ++c) {
+      if (std::isnan(peak[c]) || held_peak_[c] > peak[c]) peak[c] = held_peak_[c];
+    }
+    d.j_peak(peak);
+    if (uplink_.offer(d, now) != UplinkReason::kNone) {
+      dds::write(*status_writer_, d);
+      held_peak_.fill(std::numeric_limits<double>::quiet_NaN());
+    } else {
+      held_peak_ = peak;
+    }
   };
   // This run's incarnation: its start time (microseconds since the Unix epoch), above that
   // of every restored event even if the clock went back.

@@ -121,6 +121,15 @@ bool StatusUplink::discrete_change(const fdi::FdiStatus& a, const fdi::FdiStatus
     return changed("a counter went back");
   }
   if (!same(a.reference_speed(), b.reference_speed())) return changed("reference_speed");
+  if (a.model_mismatch() != b.model_mismatch()) return changed("model_mismatch");
+  // A residual that goes above its leave threshold (a suspicion) or back below is news; its
+  // level in between is not.
+  for (int c = 0; c < 2; ++c) {
+    const auto above = [c](const fdi::FdiStatus& s) {
+      return s.j_leave()[c] > 0.0 && s.j_peak()[c] > s.j_leave()[c];
+    };
+    if (above(a) != above(b)) return changed("residual above its leave threshold");
+  }
   // A value that appears, goes away (NaN) or becomes infinite is news, not a deviation.
   const auto flip = [](double x, double y) { return std::isfinite(x) != std::isfinite(y); };
   for (int i = 0; i < 4; ++i) {

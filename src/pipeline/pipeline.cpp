@@ -411,6 +411,16 @@ void FdiPipeline::process(const Sample& s) {
   ++samples_;
   last_t_ = s.t;
   last_u_ = s.u;
+  // The largest J_N per channel until the next status (a peak between two statuses is shown).
+  const IsolatorStatus& ist = iso_.status();
+  if (ist.armed) {
+    for (int c = 0; c < 2; ++c) {
+      const double j = ist.J(c);
+      if (std::isfinite(j) && !(j <= j_peak_[static_cast<std::size_t>(c)])) {
+        j_peak_[static_cast<std::size_t>(c)] = j;
+      }
+    }
+  }
   // The rudder pauses identification and isolation: say so when it starts and ends.
   const InputHealth& in = iso_.status().input;
   if (!in.delta_ok && !rudder_paused_) {
@@ -630,6 +640,13 @@ PipelineStatus FdiPipeline::make_status() {
   st.surge_speed = last_u_;
   st.estimate = iso_.estimate();
   st.isolation = iso_.status();
+  st.j_peak = j_peak_;
+  j_peak_ = {kNaN, kNaN};
+  for (int c = 0; c < 2; ++c) {
+    st.j_raise[static_cast<std::size_t>(c)] = st.isolation.thresholds(c);
+    st.j_leave[static_cast<std::size_t>(c)] =
+        cfg_.isolation.exit_ratio * st.isolation.thresholds(c);
+  }
   st.samples = samples_.load();
   st.rejected = rejected_.load();
   st.duplicates = iso_.duplicate_samples();

@@ -174,6 +174,34 @@ test('a sidecar\'s faults on the board: raise, late browser, acknowledge, observ
   assert.equal(metric(text, `usv_fdi_fleet_silent{mmsi="${mmsi}"}`)?.[1], '0', text);
   assert.match(text, /# TYPE usv_fdi_fleet_raises_total counter/);
 
+  // The vessel's page (a link on the board): the curves behind the verdicts, drawn with uPlot
+  await page.click(`tr[data-mmsi="${mmsi}"] td.vessel a`);
+  await page.waitForURL(/vessel\.html\?mmsi=/);
+  await page.waitForSelector('#chart-j-g canvas', { timeout: 10000 });
+  const curves = await (await fetch(`${dash.url}api/vessel?mmsi=${mmsi}`)).json();
+  const over = (c) => curves.t.some((_, i) => curves['j_' + c][i] > curves['raise_' + c][i] &&
+                                             curves['raise_' + c][i] > 0);
+  assert.ok(curves.t.length >= 3, JSON.stringify(curves));
+  assert.ok(over('g'), `the gyro fault's J_N above its raise threshold: ${JSON.stringify(curves)}`);
+  assert.ok(over('a'), `the accelerometer fault's J_N above its threshold: ${JSON.stringify(curves)}`);
+  assert.ok(curves.armed.includes(1) && curves.c_g.some((c) => c > 0.9), JSON.stringify(curves));
+  assert.ok(curves.t.every((t, i) => i === 0 || t > curves.t[i - 1]), 'time runs forward');
+  await waitFor('every point on the page', async () =>
+    Number(await page.getAttribute('body', 'data-points')) >= curves.t.length, 10);
+  assert.match(await page.textContent('#chart-j-g'), /J_N gyro.*raise threshold.*leave threshold/s);
+  assert.equal(await page.textContent('#detector tr[data-key="armed"] td'), 'armed');
+  // the gyro's event, acknowledged above, is no longer active-unacknowledged here either
+  assert.notEqual(await page.getAttribute('#faults tr[data-sensor="gyro"]', 'data-presentation'),
+                  'active-unacknowledged');
+  await page.screenshot({ path: path.join(out, 'vessel.png'), fullPage: true });
+  // A wrong address says what is wrong.
+  const wrong = await fetch(`${dash.url}api/vessel?mmsi=12x`);
+  assert.equal(wrong.status, 400);
+  assert.match((await wrong.json()).error, /mmsi/);
+  assert.equal((await fetch(`${dash.url}api/vessel?mmsi=5`)).status, 404);
+  await page.goto(dash.url);
+  await page.waitForSelector(`tr[data-mmsi="${mmsi}"]`, { timeout: 10000 });
+
   // WHEN an observer's dashboard (--read-only) shows the same fleet
   const obs = await dashboard('observer', part, ['--read-only']);
   const op = await newPage();

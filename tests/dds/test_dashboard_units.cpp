@@ -8,6 +8,7 @@
 
 #include "dashboard/board.hpp"
 #include "dashboard/metrics.hpp"
+#include "dashboard/vessel_history.hpp"
 
 namespace usvfdi::app::dashboard {
 namespace {
@@ -169,6 +170,47 @@ TEST(DashboardBoard, TheSidecarsRecordOfAnAckNamesTheOperatorWithOrWithoutItsIde
   EXPECT_FALSE(acknowledged_by("acknowledged by :carol", "carol"));
   EXPECT_FALSE(acknowledged_by("acknowledged by dashboard:carol", ""));
   EXPECT_FALSE(acknowledged_by("residual back below 3.0", "carol"));
+}
+
+TEST(DashboardVesselHistory, AVesselsStatusesAreKeptAsChartColumnsBoundedAndInTimeOrder) {
+  VesselHistory h(3);
+  const auto status = [](std::uint32_t mmsi, double written, double jg) {
+    VesselStatus v;
+    v.st.mmsi(mmsi);
+    v.written = written;
+    v.st.j_peak({std::numeric_limits<double>::quiet_NaN(), jg});
+    v.st.j_raise({6.0, 6.5});
+    v.st.j_leave({3.0, 3.25});
+    v.st.c_g(0.3);
+    v.st.a({-1.0, 0.5, 0.25, -2.0});
+    v.st.armed(true);
+    return v;
+  };
+  nlohmann::json j;
+  EXPECT_FALSE(h.to_json(7, 0.0, &j));
+  h.add(status(7, 10.0, 1.0));
+  h.add(status(7, 10.0, 9.0));  // a repeat of the same time: not again
+  h.add(status(7, 9.0, 9.0));   // older: not added
+  h.add(status(8, 10.5, 2.0));  // another vessel
+  h.add(status(7, 11.0, 2.0));
+  h.add(status(7, 12.0, 7.5));
+  h.add(status(7, 13.0, 3.0));  // the fourth point of vessel 7: the first goes
+  ASSERT_TRUE(h.to_json(7, 0.0, &j));
+  EXPECT_EQ(j["mmsi"], 7);
+  EXPECT_EQ(j["capacity"], 3);
+  EXPECT_EQ(j["t"], nlohmann::json({11.0, 12.0, 13.0}));
+  EXPECT_EQ(j["j_g"], nlohmann::json({2.0, 7.5, 3.0}));
+  EXPECT_EQ(j["j_a"], nlohmann::json({nullptr, nullptr, nullptr})) << "NaN is null";
+  EXPECT_EQ(j["raise_g"][0], 6.5);
+  EXPECT_EQ(j["leave_g"][0], 3.25);
+  EXPECT_EQ(j["c_g"][0], 0.3) << "a float sent in its shortest form";
+  EXPECT_EQ(j["a12"][2], 0.5);
+  EXPECT_EQ(j["a22"][2], -2.0);
+  EXPECT_EQ(j["armed"][1], 1.0);
+  for (const char* k : VesselHistory::kSeries) EXPECT_EQ(j[k].size(), 3u) << k;
+  ASSERT_TRUE(h.to_json(7, 12.0, &j));  // only what is newer than the last point shown
+  EXPECT_EQ(j["t"], nlohmann::json({13.0}));
+  EXPECT_EQ(h.vessels(), 2u);
 }
 
 TEST(DashboardBoard, AnAckRequestIsCheckedFieldByField) {

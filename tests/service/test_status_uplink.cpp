@@ -28,6 +28,11 @@ fdi::FdiStatus healthy() {
   s.surge_speed(7.0);
   s.speed_ratio(1.0);
   s.reference_speed(7.0);
+  s.j_peak({1.2, 1.5});
+  s.j_raise({6.0, 8.0});
+  s.j_leave({3.0, 4.0});
+  s.c_a(0.3);
+  s.c_g(0.4);
   s.message("armed; ");
   return s;
 }
@@ -79,6 +84,15 @@ TEST(StatusUplink, EveryDiscreteChangeIsSentAtOnce) {
       {"a value became or stopped being finite", [](fdi::FdiStatus* s) { s->surge_speed(NAN); }},
       {"a value became or stopped being finite", [](fdi::FdiStatus* s) { s->sigma_v(INFINITY); }},
       {"incarnation", [](fdi::FdiStatus* s) { s->incarnation(2); }},
+      {"model_mismatch", [](fdi::FdiStatus* s) { s->model_mismatch(true); }},
+      {"residual above its leave threshold",
+       [](fdi::FdiStatus* s) {
+         s->j_peak({1.2, 4.5});
+       }},
+      {"residual above its leave threshold",
+       [](fdi::FdiStatus* s) {
+         s->j_peak({3.5, 1.5});
+       }},
   };
   for (const Change& c : changes) {
     StatusUplink u;
@@ -90,6 +104,22 @@ TEST(StatusUplink, EveryDiscreteChangeIsSentAtOnce) {
     EXPECT_EQ(u.last_change(), c.name);
     EXPECT_EQ(u.offer(s, 3.0), UplinkReason::kNone) << c.name << ": sent once";
   }
+}
+
+TEST(StatusUplink, AResidualsLevelBelowItsLeaveThresholdIsNoNews) {
+  StatusUplink u;
+  fdi::FdiStatus s = healthy();
+  ASSERT_EQ(u.offer(s, 0.0), UplinkReason::kFirst);
+  // J_N wanders under the leave threshold, the confidences move: nothing is sent before the
+  // heartbeat (3 s)
+  for (int i = 1; i < 20; ++i) {
+    s.j_peak({0.5 + 0.1 * i, 3.9 - 0.1 * i});
+    s.c_a(0.05 * i);
+    EXPECT_EQ(u.offer(s, 0.1 * i), UplinkReason::kNone) << i;
+  }
+  // NaN (none computed) is below every threshold
+  s.j_peak({NAN, NAN});
+  EXPECT_EQ(u.offer(s, 2.0), UplinkReason::kNone);
 }
 
 TEST(StatusUplink, AMovingEstimateIsSentWhenItLeavesTheTolerance) {

@@ -1,8 +1,10 @@
 // The usv-fdi sidecar: the FDI pipeline behind Fast DDS readers and writers.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -145,7 +147,10 @@ class FdiService {
   std::unique_ptr<NmeaInput> nmea_;  ///< input: nmea (the INS and rudder readers are not made)
   std::unique_ptr<EventWatch> watch_;
   StatusUplink uplink_;  ///< the publisher thread's, then stop()'s
-  int lock_fd_ = -1;     ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
+  /// J_N peaks of statuses the uplink did not send, handed on to the next one sent.
+  std::array<double, 2> held_peak_{std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN()};
+  int lock_fd_ = -1;  ///< <state_dir>/usv-fdi-<mmsi>.lock, flock()ed while the sidecar runs
   std::unique_ptr<usvfdi::dds::DdsContext> dds_;
   /// The participant of the ack reader alone (its own port and receive thread).
   std::unique_ptr<usvfdi::dds::DdsContext> ack_dds_;

@@ -232,6 +232,9 @@ struct PipelineStatus {
   /// Faults raised by this run per Sensor (published transitions into raised; a refined kind
   /// and a restored event are none).
   std::array<std::uint64_t, 3> raises{0, 0, 0};
+  /// Per channel [accelerometer, gyro]: the largest J_N since the previous status (NaN: none
+  /// computed), and the enter (raise) and leave thresholds in force (0: none yet).
+  std::array<double, 2> j_peak{kNaN, kNaN}, j_raise{0.0, 0.0}, j_leave{0.0, 0.0};
 };
 
 /// Wall-clock seconds since each thread last went round its loop (an idle thread still goes
@@ -396,7 +399,8 @@ class FdiPipeline {
   std::array<std::uint64_t, 3> current_incarnation_{0, 0, 0};
   std::array<Recheck, 3> recheck_{};
   double last_t_ = kNaN;
-  double last_u_ = kNaN;  ///< surge speed of the last sample processed
+  double last_u_ = kNaN;                      ///< surge speed of the last sample processed
+  std::array<double, 2> j_peak_{kNaN, kNaN};  ///< largest J_N per channel since the last status
   double newest_ins_stamp_ = -1e300;
   std::uint64_t seen_version_ = 0;
   InputProblems problems_;

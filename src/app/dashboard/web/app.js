@@ -85,7 +85,8 @@ function renderBoard() {
   body.replaceChildren();
   for (const v of board.vessels) {
     const tr = el('tr', { 'data-mmsi': v.mmsi, class: v.silent || v.never_heard ? 'silent' : '' });
-    tr.append(el('td', { class: 'vessel' }, v.mmsi));
+    tr.append(el('td', { class: 'vessel' },
+      el('a', { href: `/vessel.html?mmsi=${v.mmsi}`, title: 'this vessel\'s page: the curves behind the verdicts' }, v.mmsi)));
     const heard = v.never_heard ? 'never heard' :
       (v.silent ? 'SILENT ' : '') + age(v.heard_age_s) + ' ago';
     tr.append(el('td', { class: 'heard', 'data-silent': v.silent }, heard));
