@@ -10,9 +10,15 @@
 //
 // Threads: the main thread owns DDS and the fleet view; the HTTP server's threads see only the
 // Hub (the latest board as text, and the queue of acknowledgements asked for).
+#include <fcntl.h>
 #include <spdlog/spdlog.h>
 #include <termios.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <iterator>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 
@@ -154,7 +160,7 @@ class Hub {
 
 void reply_json(httplib::Response& res, int status, const json& j) {
   res.status = status;
-  res.set_content(j.dump(), "application/json");
+  res.set_content(j.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
 }
 
 /// The Host values a request may carry (empty: any, when listening on every address): a page
@@ -189,10 +195,17 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
       return httplib::Server::HandlerResponse::Handled;
     }
     // With accounts, nothing (page, board, stream, metrics, acks) without valid credentials.
-    if (auth != nullptr && !requester(auth, req)) {
+    if (auth != nullptr) {
+      const db::Authenticator::Result r = auth->authenticate(req.get_header_value("Authorization"));
+      if (r.account) return httplib::Server::HandlerResponse::Unhandled;
+      if (r.busy) {
+        res.set_header("Retry-After", "1");
+        reply_json(res, 503, {{"error", "too many sign-ins being checked; try again"}});
+        return httplib::Server::HandlerResponse::Handled;
+      }
       if (req.has_header("Authorization")) {
-        spdlog::warn("refused {} {} from {}: wrong name or password", req.method, req.path,
-                     req.remote_addr);
+        spdlog::warn("refused {} {} from {}: wrong name or password (for '{}')", req.method,
+                     escape_text(req.path), req.remote_addr, escape_text(r.tried));
       }
       res.set_header("WWW-Authenticate", "Basic realm=\"usv-fdi dashboard\", charset=\"UTF-8\"");
       reply_json(res, 401, {{"error", "sign in with a dashboard account"}});
@@ -200,9 +213,20 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
+  // Every answer: not to be framed by another site (a hidden Acknowledge button), no sniffing
+  // of types; with TLS, browsers keep to HTTPS.
+  const bool tls = a.tls();
+  svr.set_post_routing_handler([tls](const httplib::Request&, httplib::Response& res) {
+    res.set_header("X-Frame-Options", "DENY");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    if (!res.has_header("Content-Security-Policy")) {
+      res.set_header("Content-Security-Policy", "default-src 'self'; frame-ancestors 'none'");
+    }
+    if (tls) res.set_header("Strict-Transport-Security", "max-age=31536000");
+  });
   const auto page = [](const char* body, const char* type) {
     return [body, type](const httplib::Request&, httplib::Response& res) {
-      res.set_header("Content-Security-Policy", "default-src 'self'");
+      res.set_header("Content-Security-Policy", "default-src 'self'; frame-ancestors 'none'");
       res.set_header("Cache-Control", "no-cache");
       res.set_content(body, type);
     };
@@ -263,9 +287,10 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
     const std::optional<db::Account> who = requester(auth, req);
     const bool can_ack = who && who->role == db::Role::kOperator && !a.read_only;
     res.set_header("Cache-Control", "no-cache");
+    // (an operator on a read-only dashboard stays an operator who cannot acknowledge here)
     reply_json(res, 200,
                {{"name", who && !who->name.empty() ? json(who->name) : json(nullptr)},
-                {"role", can_ack ? "operator" : "observer"},
+                {"role", who && !a.read_only ? db::to_string(who->role) : "observer"},
                 {"can_ack", can_ack}});
   });
   svr.Get("/metrics", [&hub](const httplib::Request&, httplib::Response& res) {
@@ -658,9 +683,10 @@ int run_dashboard(DashboardArgs& a) {
     }
     std::error_code ec;
     const auto perms = std::filesystem::status(a.accounts, ec).permissions();
-    if (!ec && (perms & std::filesystem::perms::others_read) != std::filesystem::perms::none) {
+    const auto shared = std::filesystem::perms::others_read | std::filesystem::perms::group_read;
+    if (!ec && (perms & shared) != std::filesystem::perms::none) {
       spdlog::warn(
-          "--accounts {}: every user of this host may read the password hashes "
+          "--accounts {}: other users of this host may read the password hashes "
           "(chmod 600)",
           a.accounts);
     }
@@ -751,16 +777,75 @@ struct AccountArgs {
 /// usv-fdi dashboard-account: reads a password (the first line of stdin; typed without echo on
 /// a terminal) and prints the account's entry for the accounts file, the password salted and
 /// hashed.
+termios g_saved_tty{};
+bool g_tty_quiet = false;
+
+/// Ctrl-C (or a stop) while the password is typed without echo: echo back on, then the default.
+void restore_tty_and_die(int sig) {
+  if (g_tty_quiet) tcsetattr(STDIN_FILENO, TCSAFLUSH, &g_saved_tty);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+/// Reads one line of stdin; on a terminal, prompted on stderr and typed without echo.
+bool read_secret(const std::string& prompt, bool tty, std::string* out) {
+  if (tty) {
+    std::cerr << prompt << std::flush;
+    if (tcgetattr(STDIN_FILENO, &g_saved_tty) == 0) {
+      termios quiet = g_saved_tty;
+      quiet.c_lflag &= ~static_cast<tcflag_t>(ECHO);
+      std::signal(SIGINT, restore_tty_and_die);
+      std::signal(SIGTERM, restore_tty_and_die);
+      std::signal(SIGQUIT, restore_tty_and_die);
+      g_tty_quiet = tcsetattr(STDIN_FILENO, TCSAFLUSH, &quiet) == 0;
+    }
+  }
+  const bool got = static_cast<bool>(std::getline(std::cin, *out));
+  if (tty) {
+    if (g_tty_quiet) tcsetattr(STDIN_FILENO, TCSAFLUSH, &g_saved_tty);
+    g_tty_quiet = false;
+    std::cerr << "\n";
+  }
+  if (!out->empty() && out->back() == '\r') out->pop_back();
+  return got;
+}
+
+/// Writes `text` to `path` through a new file of mode 0600 beside it, renamed over it (the old
+/// file is never half written, the hashes are never readable by others). False on failure.
+bool replace_file(const std::string& path, const std::string& text, std::string* why) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    *why = "cannot create " + tmp + ": " + std::strerror(errno);
+    return false;
+  }
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  const bool ok = done == text.size() && ::fsync(fd) == 0;
+  ::close(fd);
+  if (!ok || ::rename(tmp.c_str(), path.c_str()) != 0) {
+    *why = "cannot write " + path + ": " + std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return false;
+  }
+  return true;
+}
+
 int run_dashboard_account(const AccountArgs& a) {
   if (const std::string why = db::check_account_name(a.name); !why.empty()) {
     spdlog::error("account name '{}': {}", escape_text(a.name), why);
     return kExitUsage;
   }
-  bool fresh = true;  // the file is missing or empty: it starts with `accounts:`
+  std::string before;  // the accounts file as it is ("" when missing or blank)
   if (!a.file.empty()) {
-    std::ifstream in(a.file);
-    fresh = !in.good() || in.peek() == std::ifstream::traits_type::eof();
-    if (!fresh) {
+    std::ifstream in(a.file, std::ios::binary);
+    before.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (before.find_first_not_of(" \t\r\n") == std::string::npos) before.clear();
+    if (!before.empty()) {
       try {
         if (db::load_accounts(a.file).count(a.name) > 0) {
           spdlog::error("{} has an account '{}' already (remove its entry to set a new password)",
@@ -774,24 +859,14 @@ int run_dashboard_account(const AccountArgs& a) {
     }
   }
   const bool tty = isatty(STDIN_FILENO) != 0;
-  termios saved{};
-  if (tty) {
-    std::cerr << "password for " << a.name << ": " << std::flush;
-    if (tcgetattr(STDIN_FILENO, &saved) == 0) {
-      termios quiet = saved;
-      quiet.c_lflag &= ~static_cast<tcflag_t>(ECHO);
-      tcsetattr(STDIN_FILENO, TCSAFLUSH, &quiet);
-    }
-  }
-  std::string password;
-  const bool got = static_cast<bool>(std::getline(std::cin, password));
-  if (tty) {
-    tcsetattr(STDIN_FILENO, TCSAFLUSH, &saved);
-    std::cerr << "\n";
-  }
-  if (!password.empty() && password.back() == '\r') password.pop_back();
+  std::string password, again;
+  const bool got = read_secret("password for " + a.name + ": ", tty, &password);
   if (!got || password.size() < 8) {
     spdlog::error("the password (the first line of stdin) must have at least 8 characters");
+    return kExitUsage;
+  }
+  if (tty && (!read_secret("the same again: ", tty, &again) || again != password)) {
+    spdlog::error("the two passwords differ: nothing written");
     return kExitUsage;
   }
   const db::Role role = a.role == "observer" ? db::Role::kObserver : db::Role::kOperator;
@@ -801,17 +876,33 @@ int run_dashboard_account(const AccountArgs& a) {
     std::cout << entry;
     return kExitOk;
   }
-  std::ofstream out(a.file, std::ios::app);
-  if (fresh && out) {
-    // The hashes are for the dashboard's eyes only: a new file is its owner's alone.
-    std::error_code ec;
-    std::filesystem::permissions(
-        a.file, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write, ec);
+  // The entry goes at the end of the file (the accounts list must be its last key), read back
+  // before it replaces the file: a layout it cannot be appended to is said, nothing is lost.
+  std::string text = before.empty() ? std::string("accounts:\n") : before;
+  if (text.back() != '\n') text += '\n';
+  text += entry;
+  const std::string check = a.file + ".check." + std::to_string(::getpid());
+  std::string why;
+  bool fits = false;
+  if (replace_file(check, text, &why)) {
+    try {
+      const auto accounts = db::load_accounts(check);
+      fits = accounts.count(a.name) > 0 &&
+             (before.empty() || accounts.size() == db::load_accounts(a.file).size() + 1);
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+    ::unlink(check.c_str());
   }
-  out << (fresh ? "accounts:\n" : "") << entry;
-  out.flush();
-  if (!out) {
-    spdlog::error("cannot write {}", a.file);
+  if (!fits) {
+    spdlog::error(
+        "cannot append to {} ({}): its accounts list is not its last, block-indented key; add "
+        "this entry to the list by hand:\n{}",
+        a.file, why.empty() ? "the entry did not read back" : why, entry);
+    return kExitFailure;
+  }
+  if (!replace_file(a.file, text, &why)) {
+    spdlog::error("{}", why);
     return kExitFailure;
   }
   spdlog::info("{} account '{}' added to {}", to_string(role), escape_text(a.name), a.file);

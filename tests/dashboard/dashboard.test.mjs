@@ -316,6 +316,8 @@ test('signed in over HTTPS: operators acknowledge under their own name, observer
     const r = await get(p);
     assert.equal(r.status, 401, `${p} without credentials`);
     assert.match(r.headers['www-authenticate'], /^Basic realm="usv-fdi dashboard"/);
+    assert.equal(r.headers['x-frame-options'], 'DENY', 'no other site may frame it');
+    assert.match(r.headers['strict-transport-security'] ?? '', /max-age=/);
   }
   assert.equal((await get('/api/board', 'carol:correct horse')).status, 401, 'a wrong password');
   assert.equal((await get('/api/board', 'mallory:correct horse battery')).status, 401, 'no such account');

@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dashboard/accounts.hpp"
 
@@ -108,9 +111,54 @@ TEST(DashboardAccounts, TheAccountsFileIsCheckedEntryByEntry) {
       error_of("key.yaml", "accounts:\n  - {name: a, role: operator, pasword: '" + ok + "'}\n")
           .find("unknown key 'pasword'"),
       std::string::npos);
+  EXPECT_NE(error_of("dupkey.yaml",
+                     "accounts:\n  - {name: a, name: b, role: operator, password: '" + ok + "'}\n")
+                .find("'name' is given twice"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of("list.yaml", "accounts:\n  - {name: [a], role: operator, password: '" + ok + "'}\n")
+          .find("name must be a text value"),
+      std::string::npos);
+  const std::string spaced = "pbkdf2-sha256$ 1000$" + ok.substr(ok.find('$', 14) + 1);
+  const std::string e = error_of(
+      "iter.yaml", "accounts:\n  - {name: a, role: operator, password: '" + spaced + "'}\n");
+  EXPECT_NE(e.find("iteration count ' 1000'"), std::string::npos) << e;
+  EXPECT_EQ(e.find("in clear"), std::string::npos) << "a malformed hash is not a password in clear";
   EXPECT_NE(error_of("empty.yaml", "accounts: []\n").find("top level"), std::string::npos);
   EXPECT_NE(error_of("yaml.yaml", "accounts: [\n").find("accounts file"), std::string::npos);
   EXPECT_NE(error_of("missing", "").find("top level"), std::string::npos);
+}
+
+TEST(DashboardAccounts, ANameReadsAsWhatItIs) {
+  EXPECT_EQ(check_account_name("alice"), "");
+  EXPECT_EQ(check_account_name("Åsa Öberg"), "");
+  EXPECT_EQ(check_account_name("船長 1"), "");
+  EXPECT_NE(check_account_name(""), "");
+  EXPECT_NE(check_account_name(std::string(64, 'a')), "");
+  EXPECT_NE(check_account_name(" alice"), "");
+  EXPECT_NE(check_account_name("alice "), "");
+  EXPECT_NE(check_account_name("a:b"), "");
+  EXPECT_NE(check_account_name("a\tb"), "");
+  EXPECT_EQ(check_account_name("bad\xff utf"), "not valid UTF-8");
+  EXPECT_EQ(check_account_name("\xc0\xaf"), "not valid UTF-8") << "overlong";
+  EXPECT_EQ(check_account_name("a\xe2\x80"), "not valid UTF-8") << "cut short";
+  EXPECT_NE(check_account_name("alice\xe2\x80\xae"), "") << "U+202E right-to-left override";
+  EXPECT_NE(check_account_name("a\xe2\x80\xa8"
+                               "b"),
+            "")
+      << "U+2028 line separator";
+  EXPECT_NE(check_account_name("a\xc2\x85"
+                               "b"),
+            "")
+      << "U+0085, a C1 control";
+  EXPECT_NE(check_account_name("\xef\xbb\xbf"
+                               "alice"),
+            "")
+      << "U+FEFF";
+  EXPECT_NE(check_account_name("al\xe2\x80\x8b"
+                               "ice"),
+            "")
+      << "U+200B zero width space";
 }
 
 TEST(DashboardAccounts, BasicCredentialsProveTheirAccountOnly) {
@@ -135,6 +183,40 @@ TEST(DashboardAccounts, BasicCredentialsProveTheirAccountOnly) {
   EXPECT_FALSE(auth.check("").has_value());
   EXPECT_FALSE(auth.check("Bearer abc").has_value());
   EXPECT_FALSE(auth.check("Basic !!!!").has_value());
+  // more than one space after the scheme is allowed (RFC 7617), base64 only in canonical form
+  EXPECT_TRUE(auth.check("Basic   " + basic("alice:correct horse").substr(6)).has_value());
+  std::string b = basic("ab:c");  // "YWI6Yw==": its last character holds padding bits
+  ASSERT_EQ(b, "Basic YWI6Yw==");
+  EXPECT_FALSE(auth.check("Basic YWI6Yx==").has_value()) << "non-zero padding bits";
+  // what was tried is said, for the log
+  const auto r = auth.authenticate(basic("carol:x"));
+  EXPECT_FALSE(r.account.has_value());
+  EXPECT_FALSE(r.busy);
+  EXPECT_EQ(r.tried, "carol");
+  EXPECT_THROW(Authenticator(std::map<std::string, Account>{}), std::invalid_argument);
+}
+
+TEST(DashboardAccounts, AnUnknownNameTakesAsLongAsTheSlowestAccount) {
+  std::map<std::string, Account> acc;
+  acc["fast"] = {"fast", Role::kOperator, hash_password("correct horse", kFast)};
+  acc["slow"] = {"slow", Role::kOperator, hash_password("correct horse", 200000)};
+  Authenticator auth(acc);
+  using Clock = std::chrono::steady_clock;
+  const auto time_of = [&](const std::string& who) {
+    const auto t0 = Clock::now();
+    EXPECT_FALSE(auth.check(basic(who + ":wrong password")).has_value());
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  // Medians of 3, side by side: an unknown name costs the slow account's derivation (200x the
+  // fast one's), so it is never as cheap as the fast account's.
+  std::vector<double> fast, unknown;
+  for (int i = 0; i < 3; ++i) {
+    fast.push_back(time_of("fast"));
+    unknown.push_back(time_of("nobody"));
+  }
+  std::sort(fast.begin(), fast.end());
+  std::sort(unknown.begin(), unknown.end());
+  EXPECT_GT(unknown[1], 5.0 * fast[1]) << unknown[1] << " s vs " << fast[1] << " s";
 }
 
 }  // namespace

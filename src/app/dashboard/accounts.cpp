@@ -2,6 +2,7 @@
 
 #include <openssl/crypto.h>
 #include <openssl/evp.h>
+#include <openssl/hmac.h>
 #include <openssl/rand.h>
 #include <yaml-cpp/yaml.h>
 
@@ -46,6 +47,8 @@ std::optional<std::vector<unsigned char>> b64_decode(const std::string& s) {
   if (s[s.size() - 1] == '=') --n;  // EVP_DecodeBlock counts the padding as zero bytes
   if (s[s.size() - 2] == '=') --n;
   out.resize(n);
+  // Canonical only: '=' as trailing padding alone, zero padding bits (one text per value).
+  if (b64_encode(out.data(), out.size()) != s) return std::nullopt;
   return out;
 }
 
@@ -72,11 +75,11 @@ std::optional<Parsed> parse_hash(const std::string& stored, std::string* why) {
   Parsed p;
   try {
     std::size_t used = 0;
-    const unsigned long it = std::stoul(parts[1], &used);
-    if (used != parts[1].size() || parts[1][0] == '-' || it < kMinIterations ||
-        it > kMaxIterations) {
-      throw std::out_of_range("iterations");
+    if (parts[1].empty() || parts[1].find_first_not_of("0123456789") != std::string::npos) {
+      throw std::invalid_argument("iterations");
     }
+    const unsigned long it = std::stoul(parts[1], &used);
+    if (it < kMinIterations || it > kMaxIterations) throw std::out_of_range("iterations");
     p.iterations = static_cast<unsigned>(it);
   } catch (const std::exception&) {
     *why = "its iteration count '" + parts[1] + "' is not a whole number from " +
@@ -109,19 +112,46 @@ std::vector<unsigned char> derive(const std::string& password,
   return out;
 }
 
-std::string sha256_hex(const std::string& s) {
-  unsigned char md[EVP_MAX_MD_SIZE];
-  unsigned int n = 0;
-  if (EVP_Digest(s.data(), s.size(), md, &n, EVP_sha256(), nullptr) != 1) {
-    throw std::runtime_error("SHA-256 failed (OpenSSL)");
+/// The code point of the UTF-8 sequence at s[*i] (advancing *i), -1 if it is not valid UTF-8
+/// (overlong forms, surrogates and values past U+10FFFF included).
+long next_code_point(const std::string& s, std::size_t* i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = byte(*i);
+  int extra = 0;
+  long cp = 0;
+  if (c < 0x80) {
+    ++*i;
+    return c;
+  } else if ((c & 0xE0) == 0xC0) {
+    extra = 1;
+    cp = c & 0x1F;
+  } else if ((c & 0xF0) == 0xE0) {
+    extra = 2;
+    cp = c & 0x0F;
+  } else if ((c & 0xF8) == 0xF0) {
+    extra = 3;
+    cp = c & 0x07;
+  } else {
+    return -1;
   }
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  for (unsigned i = 0; i < n; ++i) {
-    out += hex[md[i] >> 4];
-    out += hex[md[i] & 15];
+  if (*i + static_cast<std::size_t>(extra) >= s.size()) return -1;  // cut short
+  for (int k = 1; k <= extra; ++k) {
+    const unsigned char b = byte(*i + static_cast<std::size_t>(k));
+    if ((b & 0xC0) != 0x80) return -1;
+    cp = (cp << 6) | (b & 0x3F);
   }
-  return out;
+  static const long kMin[] = {0, 0x80, 0x800, 0x10000};
+  if (cp < kMin[extra] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return -1;
+  *i += static_cast<std::size_t>(extra) + 1;
+  return cp;
+}
+
+/// Characters that change how the rest of a line reads or do not show: C1 controls, soft hyphen,
+/// zero-width and direction marks, line/paragraph separators, embeddings and isolates, the BOM.
+bool invisible(long cp) {
+  return (cp >= 0x80 && cp <= 0x9F) || cp == 0xAD || cp == 0x061C || cp == 0x180E ||
+         (cp >= 0x200B && cp <= 0x200F) || (cp >= 0x2028 && cp <= 0x202E) ||
+         (cp >= 0x2060 && cp <= 0x206F) || cp == 0xFEFF || (cp >= 0xFFF9 && cp <= 0xFFFB);
 }
 
 }  // namespace
@@ -156,10 +186,14 @@ bool verify_password(const std::string& password, const std::string& stored) {
 }
 
 std::string check_account_name(const std::string& name) {
-  if (name.empty() || name.size() > 63) return "a name has 1 to 63 characters";
-  for (const char c : name) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "control characters";
-    if (c == ':') return "':' (HTTP Basic separates the name from the password with it)";
+  if (name.empty() || name.size() > 63) return "a name has 1 to 63 bytes (UTF-8)";
+  if (name.front() == ' ' || name.back() == ' ') return "a space at its start or end";
+  for (std::size_t i = 0; i < name.size();) {
+    const long cp = next_code_point(name, &i);
+    if (cp < 0) return "not valid UTF-8";
+    if (cp < 0x20 || cp == 0x7f) return "control characters";
+    if (cp == ':') return "':' (HTTP Basic separates the name from the password with it)";
+    if (invisible(cp)) return "an invisible or direction-changing character";
   }
   return {};
 }
@@ -184,20 +218,23 @@ std::map<std::string, Account> load_accounts(const std::string& path) {
     const std::string where =
         "account " + std::to_string(++i) + " (line " + std::to_string(n.Mark().line + 1) + ")";
     if (!n.IsMap()) throw fail(where, "expected a map {name, role, password}");
+    std::set<std::string> keys;
     for (const auto& kv : n) {
       const std::string k = kv.first.as<std::string>();
       if (k != "name" && k != "role" && k != "password") {
         throw fail(where, "unknown key '" + k + "' (name, role, password)");
       }
+      if (!keys.insert(k).second) throw fail(where, "'" + k + "' is given twice");
+      if (!kv.second.IsScalar()) throw fail(where, k + " must be a text value");
     }
     Account a;
-    if (!n["name"] || !n["name"].IsScalar()) throw fail(where, "name is missing");
+    if (!n["name"]) throw fail(where, "name is missing");
     a.name = n["name"].as<std::string>();
     if (const std::string why = check_account_name(a.name); !why.empty()) {
       throw fail(where, "name '" + a.name + "': " + why);
     }
     const std::string who = where + ", '" + a.name + "'";
-    if (!n["role"] || !n["role"].IsScalar()) throw fail(who, "role is missing");
+    if (!n["role"]) throw fail(who, "role is missing");
     const std::string role = n["role"].as<std::string>();
     if (role == "operator") {
       a.role = Role::kOperator;
@@ -206,10 +243,12 @@ std::map<std::string, Account> load_accounts(const std::string& path) {
     } else {
       throw fail(who, "role '" + role + "': expected operator or observer");
     }
-    if (!n["password"] || !n["password"].IsScalar()) throw fail(who, "password is missing");
+    if (!n["password"]) throw fail(who, "password is missing");
     a.password_hash = n["password"].as<std::string>();
     if (const std::string why = check_password_hash(a.password_hash); !why.empty()) {
-      throw fail(who, "password: " + why + "; a password in clear is never accepted");
+      const bool clear = a.password_hash.rfind(std::string(kScheme) + "$", 0) != 0;
+      throw fail(who, "password: " + why +
+                          (clear ? "; a password in clear is never accepted" : std::string()));
     }
     if (out.count(a.name) > 0) throw fail(who, "the name is given twice");
     out[a.name] = a;
@@ -218,37 +257,86 @@ std::map<std::string, Account> load_accounts(const std::string& path) {
 }
 
 Authenticator::Authenticator(std::map<std::string, Account> accounts)
-    : accounts_(std::move(accounts)) {}
+    : accounts_(std::move(accounts)) {
+  if (accounts_.empty()) throw std::invalid_argument("no accounts");
+  // An unknown name costs what the slowest account costs: the time does not tell names apart.
+  unsigned slowest = kMinIterations;
+  for (const auto& [name, a] : accounts_) {
+    std::string why;
+    if (const auto p = parse_hash(a.password_hash, &why))
+      slowest = std::max(slowest, p->iterations);
+  }
+  dummy_hash_ = hash_password("not a password of any account", slowest);
+  unsigned char key[32];
+  if (RAND_bytes(key, sizeof key) != 1) throw std::runtime_error("no random bytes (OpenSSL)");
+  hmac_key_.assign(reinterpret_cast<const char*>(key), sizeof key);
+}
 
-std::optional<Account> Authenticator::check(const std::string& authorization) {
-  // "Basic" is case-insensitive (RFC 7617); one space, then base64(name:password).
-  if (authorization.size() < 7) return std::nullopt;
+std::string Authenticator::key_of(const std::string& authorization) const {
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  if (HMAC(EVP_sha256(), hmac_key_.data(), static_cast<int>(hmac_key_.size()),
+           reinterpret_cast<const unsigned char*>(authorization.data()), authorization.size(), md,
+           &n) == nullptr) {
+    throw std::runtime_error("HMAC-SHA256 failed (OpenSSL)");
+  }
+  return std::string(reinterpret_cast<const char*>(md), n);
+}
+
+Authenticator::Result Authenticator::authenticate(const std::string& authorization) {
+  Result out;
+  // "Basic" is case-insensitive (RFC 7617), then one or more spaces, then base64(name:password).
+  if (authorization.size() < 7) return out;
   std::string scheme = authorization.substr(0, 6);
   std::transform(scheme.begin(), scheme.end(), scheme.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (scheme != "basic ") return std::nullopt;
-  const std::string key = sha256_hex(authorization);
-  std::lock_guard<std::mutex> l(m_);
-  if (const auto it = verified_.find(key); it != verified_.end()) {
-    return accounts_.at(it->second);
-  }
-  const auto raw = b64_decode(authorization.substr(6));
-  if (!raw) return std::nullopt;
+  if (scheme != "basic ") return out;
+  const std::size_t start = authorization.find_first_not_of(' ', 6);
+  if (start == std::string::npos) return out;
+  const auto raw = b64_decode(authorization.substr(start));
+  if (!raw) return out;
   const std::string pair(raw->begin(), raw->end());
   const std::size_t colon = pair.find(':');
-  if (colon == std::string::npos) return std::nullopt;
-  const std::string name = pair.substr(0, colon), password = pair.substr(colon + 1);
-  const auto it = accounts_.find(name);
-  if (it == accounts_.end()) {
-    if (accounts_.empty()) return std::nullopt;
-    // the same work as for a known name, so that the time taken does not tell names apart
-    verify_password(password, accounts_.begin()->second.password_hash);
-    return std::nullopt;
+  if (colon == std::string::npos) return out;
+  out.tried = pair.substr(0, colon);
+  const std::string password = pair.substr(colon + 1);
+  const std::string key = key_of(authorization);
+  {
+    std::lock_guard<std::mutex> l(m_);
+    if (const auto it = verified_.find(key); it != verified_.end()) {
+      out.account = accounts_.at(it->second);
+      return out;
+    }
+    if (waiting_ >= kMaxWaiting) {
+      out.busy = true;
+      return out;
+    }
+    ++waiting_;
   }
-  if (!verify_password(password, it->second.password_hash)) return std::nullopt;
-  if (verified_.size() >= kRemembered) verified_.clear();
-  verified_[key] = name;
-  return it->second;
+  bool ok = false;
+  const auto it = accounts_.find(out.tried);
+  try {
+    std::lock_guard<std::mutex> one(derive_m_);
+    ok =
+        verify_password(password, it == accounts_.end() ? dummy_hash_ : it->second.password_hash) &&
+        it != accounts_.end();
+  } catch (...) {
+    std::lock_guard<std::mutex> l(m_);
+    --waiting_;
+    throw;
+  }
+  std::lock_guard<std::mutex> l(m_);
+  --waiting_;
+  if (!ok) return out;
+  if (verified_.emplace(key, out.tried).second) {
+    order_.push_back(key);
+    while (order_.size() > kRemembered) {
+      verified_.erase(order_.front());
+      order_.pop_front();
+    }
+  }
+  out.account = it->second;
+  return out;
 }
 
 std::string account_entry(const std::string& name, Role role, const std::string& password_hash) {

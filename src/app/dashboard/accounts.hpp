@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -43,8 +44,10 @@ bool verify_password(const std::string& password, const std::string& stored);
 /// Empty if `stored` is a well-formed hash, else what is wrong with it.
 std::string check_password_hash(const std::string& stored);
 
-/// Empty if `name` may name an account (1 to 63 characters, no control characters, no ':'),
-/// else what is wrong with it.
+/// Empty if `name` may name an account, else what is wrong with it: valid UTF-8 of 1 to 63 bytes,
+/// no control characters (C0, DEL, C1), no ':', no invisible or direction-changing characters
+/// (format characters, line and paragraph separators), no space at either end; so that the name
+/// in "acknowledged by <name>" reads as what it is.
 std::string check_account_name(const std::string& name);
 
 /// The accounts of a file (see above). Throws std::runtime_error naming the file, the entry and
@@ -52,21 +55,43 @@ std::string check_account_name(const std::string& name);
 /// password that is not a salted hash (a password in clear is refused).
 std::map<std::string, Account> load_accounts(const std::string& path);
 
-/// Checks HTTP Basic credentials against the accounts. Thread-safe; one key derivation at a
-/// time (a flood of wrong passwords costs at most one core).
+/// Checks HTTP Basic credentials against the accounts. Thread-safe. A credential verified once
+/// is remembered by its HMAC-SHA256 under a key made at start (the oldest forgotten first), and
+/// found without waiting for any key derivation; derivations run one at a time, and when
+/// kMaxWaiting already wait the request is turned away (busy) rather than queued, so a flood of
+/// wrong passwords costs at most one core and never holds up a signed-in user.
 class Authenticator {
  public:
+  /// Throws std::invalid_argument if `accounts` is empty.
   explicit Authenticator(std::map<std::string, Account> accounts);
-  /// The account an Authorization header value ("Basic base64(name:password)") proves, if any.
-  std::optional<Account> check(const std::string& authorization);
+
+  struct Result {
+    std::optional<Account> account;  ///< the account proved, if any
+    bool busy = false;               ///< not checked: too many derivations waiting
+    std::string tried;               ///< the name the credentials gave ("" if none could be read)
+  };
+  /// What an Authorization header value ("Basic base64(name:password)") proves.
+  Result authenticate(const std::string& authorization);
+  /// The account it proves, if any (busy counts as none).
+  std::optional<Account> check(const std::string& authorization) {
+    return authenticate(authorization).account;
+  }
   std::size_t size() const { return accounts_.size(); }
 
   static constexpr std::size_t kRemembered = 256;
+  static constexpr int kMaxWaiting = 4;
 
  private:
+  std::string key_of(const std::string& authorization) const;
+
   std::map<std::string, Account> accounts_;
-  std::mutex m_;
-  std::map<std::string, std::string> verified_;  ///< SHA-256 of a header value -> account name
+  std::string dummy_hash_;  ///< checked for an unknown name: as slow as the slowest account
+  std::string hmac_key_;
+  std::mutex m_;                                 ///< verified_, order_, waiting_
+  std::map<std::string, std::string> verified_;  ///< HMAC of a header value -> account name
+  std::deque<std::string> order_;                ///< verified_'s keys, oldest first
+  int waiting_ = 0;
+  std::mutex derive_m_;  ///< one key derivation at a time
 };
 
 /// An account entry for the accounts file, as `usv-fdi dashboard-account` prints it.
