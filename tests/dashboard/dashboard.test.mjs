@@ -273,6 +273,23 @@ test('a board of 100 emulated vessels loads and stays responsive', async () => {
   assert.ok(rows.length > 0 && rows.every((m) => m === target), rows.join());
   console.log(`frame after ${probe.toFixed(1)} ms, filter applied in ${Date.now() - t1} ms`);
   assert.ok(probe < 2000, `a frame took ${probe} ms`);
+  // The audible signal (IEC 62923): off until the operator switches it on; then sounding while
+  // an alert is active and unacknowledged (the tab's title counts them); Silence stops it.
+  assert.equal(await page.getAttribute('body', 'data-sounding'), 'false', 'no sound before a click');
+  await page.waitForFunction(() => /^\(\d+\) usv-fdi fleet$/.test(document.title), null, { timeout: 30000 });
+  const on = await page.evaluate(() => {
+    document.getElementById('sound').click();  // (in one task: no board arrives in between)
+    const n = Number((/^\((\d+)\)/.exec(document.title) || [0, 0])[1]);
+    return [n, document.body.dataset.sounding];
+  });
+  assert.equal(on[1], String(on[0] > 0), `sounding with ${on[0]} unacknowledged alert(s)`);
+  await page.waitForSelector('body[data-sounding="true"]', { timeout: 30000 });
+  const silenced = await page.evaluate(() => {
+    document.getElementById('silence').click();
+    return [document.body.dataset.sounding, document.getElementById('silence').textContent];
+  });
+  assert.equal(silenced[0], 'false');
+  assert.match(silenced[1], /^silenced \(30 s\)$/);
   await page.screenshot({ path: path.join(out, 'board100.png') });
   assert.deepEqual(page.errors, [], 'no script errors');
 });

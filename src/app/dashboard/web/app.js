@@ -144,7 +144,68 @@ function render() {
   renderBoard();
   renderEvents();
   renderAcks();
+  alertSignal();
 }
+
+// The audible signal of IEC 62923-1: while any alert is active and unacknowledged, a tone every
+// 2 s, once the operator has switched the sound on (a browser plays nothing before a click);
+// Silence stops it for 30 s, a new raise sounds at once. The tab's title counts the alerts.
+const SILENCE_S = 30;
+let sound = { on: false, ctx: null, silencedUntil: 0, timer: null, known: new Set() };
+function unacknowledged() {
+  const out = [];
+  for (const v of board.vessels) {
+    for (const s of SENSORS) {
+      const r = v.sensors[s];
+      if (r && r.presentation === 'active-unacknowledged') out.push(`${v.mmsi}/${s}/${r.sequence}`);
+    }
+  }
+  return out;
+}
+function beep() {
+  if (!sound.ctx) return;
+  try {
+    const o = sound.ctx.createOscillator(), g = sound.ctx.createGain();
+    o.frequency.value = 880;
+    g.gain.value = 0.2;
+    o.connect(g).connect(sound.ctx.destination);
+    o.start();
+    o.stop(sound.ctx.currentTime + 0.3);
+  } catch (e) { /* no audio device: the page still says it is sounding */ }
+}
+function alertSignal() {
+  const alerts = unacknowledged();
+  document.title = (alerts.length ? `(${alerts.length}) ` : '') + 'usv-fdi fleet';
+  // a raise not seen before ends a silence
+  if (alerts.some((a) => !sound.known.has(a))) sound.silencedUntil = 0;
+  sound.known = new Set(alerts);
+  const silenced = Date.now() < sound.silencedUntil;
+  const sounding = sound.on && alerts.length > 0 && !silenced;
+  document.body.dataset.sounding = sounding;
+  const silence = document.getElementById('silence');
+  silence.hidden = !(sound.on && alerts.length > 0);
+  silence.textContent = silenced ? `silenced (${Math.ceil((sound.silencedUntil - Date.now()) / 1000)} s)` : 'Silence';
+  if (sounding && !sound.timer) {
+    beep();
+    sound.timer = setInterval(() => { if (document.body.dataset.sounding === 'true') beep(); }, 2000);
+  } else if (!sounding && sound.timer) {
+    clearInterval(sound.timer);
+    sound.timer = null;
+  }
+}
+document.getElementById('sound').addEventListener('click', (e) => {
+  sound.on = !sound.on;
+  if (sound.on && !sound.ctx) {
+    try { sound.ctx = new AudioContext(); } catch (err) { sound.ctx = null; }
+  }
+  e.target.textContent = sound.on ? 'Sound on' : 'Sound off';
+  e.target.dataset.on = sound.on;
+  if (board) alertSignal();
+});
+document.getElementById('silence').addEventListener('click', () => {
+  sound.silencedUntil = Date.now() + SILENCE_S * 1000;
+  if (board) alertSignal();
+});
 
 async function acknowledge(mmsi, sensor, sequence, button) {
   const out = document.getElementById('ack-result');
