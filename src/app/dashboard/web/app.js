@@ -56,7 +56,8 @@ function sensorCell(v, sensor) {
   }
   cell.append(el('div', { class: 'state' }, STATE_WORDS[r.presentation] || r.presentation));
   cell.append(el('div', { class: 'detail' },
-    `${r.kind} · C_a ${fixed(r.c_a, 2)} · C_g ${fixed(r.c_g, 2)} · #${r.sequence} · ${age(r.age_s)} ago`));
+    `${r.kind} · C_a ${fixed(r.c_a, 2)} · C_g ${fixed(r.c_g, 2)} · #${r.sequence} · `,
+    el('span', { class: 'age' }, age(r.age_s) + ' ago')));
   if (!r.alive) cell.append(el('div', { class: 'detail' }, 'sidecar gone: last known state'));
   const ackable = r.state === 'raised' || r.state === 'cleared';
   if (ackable && board.can_ack && me.can_ack) {
@@ -80,25 +81,70 @@ function detector(s) {
   return parts.join(' · ');
 }
 
+// The board is pushed whole on every change; the page rebuilds only the rows that changed (a
+// board of 1000 vessels and 1000 events would otherwise be rebuilt several times a second).
+const shownRows = new Map();    // mmsi -> { key, tr }: the board's rows as drawn
+const shownEvents = new Map();  // event key -> tr: the event list's rows as drawn
+let shownFilter = null;
+
+function heardText(v) {
+  return v.never_heard ? 'never heard' : (v.silent ? 'SILENT ' : '') + age(v.heard_age_s) + ' ago';
+}
+
 function renderBoard() {
   const body = document.querySelector('#board tbody');
-  body.replaceChildren();
+  const order = [];
+  const seen = new Set();
   for (const v of board.vessels) {
-    const tr = el('tr', { 'data-mmsi': v.mmsi, class: v.silent || v.never_heard ? 'silent' : '' });
-    tr.append(el('td', { class: 'vessel' },
-      el('a', { href: `/vessel.html?mmsi=${v.mmsi}`, title: 'this vessel\'s page: the curves behind the verdicts' }, v.mmsi)));
-    const heard = v.never_heard ? 'never heard' :
-      (v.silent ? 'SILENT ' : '') + age(v.heard_age_s) + ' ago';
-    tr.append(el('td', { class: 'heard', 'data-silent': v.silent }, heard));
-    tr.append(el('td', { class: 'detector' }, detector(v.status)));
-    for (const s of SENSORS) tr.append(sensorCell(v, s));
-    body.append(tr);
+    seen.add(v.mmsi);
+    // what the row shows besides its ages: the vessel, the buttons this page may show
+    const mine = [...sent].filter((k) => k.startsWith(v.mmsi + '/')).join();
+    const key = JSON.stringify(v, (k, x) => (k === 'heard_age_s' || k === 'age_s' ? undefined : x)) +
+      `|${board.can_ack}|${me.can_ack}|${mine}`;
+    let row = shownRows.get(v.mmsi);
+    if (!row || row.key !== key) {
+      const tr = el('tr', { 'data-mmsi': v.mmsi, class: v.silent || v.never_heard ? 'silent' : '' });
+      tr.append(el('td', { class: 'vessel' },
+        el('a', { href: `/vessel.html?mmsi=${v.mmsi}`, title: 'this vessel\'s page: the curves behind the verdicts' }, v.mmsi)));
+      tr.append(el('td', { class: 'heard', 'data-silent': v.silent }, heardText(v)));
+      tr.append(el('td', { class: 'detector' }, detector(v.status)));
+      for (const s of SENSORS) tr.append(sensorCell(v, s));
+      if (row) row.tr.replaceWith(tr);
+      row = { key, tr };
+      shownRows.set(v.mmsi, row);
+    } else {
+      // the same row: only its ages move on
+      row.tr.querySelector('td.heard').textContent = heardText(v);
+      for (const s of SENSORS) {
+        const r = v.sensors[s];
+        const d = row.tr.querySelector(`td[data-sensor="${s}"] .age`);
+        if (r && d) d.textContent = age(r.age_s) + ' ago';
+      }
+    }
+    order.push(row.tr);
   }
+  for (const [m, row] of shownRows) {
+    if (!seen.has(m)) {
+      row.tr.remove();
+      shownRows.delete(m);
+    }
+  }
+  // the rows in the board's order (moved, not rebuilt, when a vessel comes or goes)
+  const now = [...body.children];
+  if (now.length !== order.length || order.some((tr, k) => now[k] !== tr)) body.replaceChildren(...order);
   const active = board.vessels.reduce((n, v) => n + SENSORS.filter(
     (s) => v.sensors[s] && v.sensors[s].presentation === 'active-unacknowledged').length, 0);
   const silent = board.vessels.filter((v) => v.silent).length;
   document.getElementById('summary').textContent =
     `${board.vessels.length} vessel(s) · ${active} unacknowledged active alert(s) · ${silent} silent`;
+}
+
+function eventRow(e) {
+  return el('tr', { 'data-mmsi': e.mmsi, 'data-sensor': e.sensor, 'data-state': e.state,
+                    'data-sequence': e.sequence },
+    el('td', {}, utc(e.written)), el('td', {}, e.mmsi), el('td', {}, e.sensor),
+    el('td', {}, e.state), el('td', {}, e.kind), el('td', {}, fixed(e.c_a, 2)),
+    el('td', {}, fixed(e.c_g, 2)), el('td', {}, e.sequence), el('td', {}, e.message));
 }
 
 function renderEvents() {
@@ -109,18 +155,36 @@ function renderEvents() {
   }
   const want = { mmsi: fv.value, sensor: document.getElementById('f-sensor').value,
                  state: document.getElementById('f-state').value };
+  const filter = JSON.stringify(want);
   const body = document.querySelector('#events tbody');
-  body.replaceChildren();
+  if (filter !== shownFilter) {
+    body.replaceChildren();
+    shownEvents.clear();
+    shownFilter = filter;
+  }
+  // Newest first: the events not drawn yet go above the newest drawn; those gone from the
+  // dashboard's history go away.
+  const keep = new Set();
+  const fresh = [];
   for (const e of board.events) {
     if (want.mmsi && String(e.mmsi) !== want.mmsi) continue;
     if (want.sensor && e.sensor !== want.sensor) continue;
     if (want.state && e.state !== want.state) continue;
-    body.append(el('tr', { 'data-mmsi': e.mmsi, 'data-sensor': e.sensor, 'data-state': e.state,
-                           'data-sequence': e.sequence },
-      el('td', {}, utc(e.written)), el('td', {}, e.mmsi), el('td', {}, e.sensor),
-      el('td', {}, e.state), el('td', {}, e.kind), el('td', {}, fixed(e.c_a, 2)),
-      el('td', {}, fixed(e.c_g, 2)), el('td', {}, e.sequence), el('td', {}, e.message)));
+    const key = `${e.mmsi}/${e.sensor}/${e.sequence}/${e.written}/${e.state}`;
+    keep.add(key);
+    if (!shownEvents.has(key)) {
+      const tr = eventRow(e);
+      shownEvents.set(key, tr);
+      fresh.push(tr);
+    }
   }
+  for (const [key, tr] of shownEvents) {
+    if (!keep.has(key)) {
+      tr.remove();
+      shownEvents.delete(key);
+    }
+  }
+  if (fresh.length) body.prepend(...fresh);
 }
 
 function renderAcks() {
