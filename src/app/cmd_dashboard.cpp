@@ -10,8 +10,8 @@
 //
 // Threads: the main thread owns DDS and the fleet view; the HTTP server's threads see only the
 // Hub (the latest board as text, and the queue of acknowledgements asked for).
-#include <fcntl.h>
 #include <spdlog/spdlog.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -53,6 +53,7 @@
 #include "dds_options.hpp"
 #include "fleet_view.hpp"
 #include "usv_fdi/core/text.hpp"
+#include "usv_fdi/io/output_file.hpp"
 
 // Last: it includes <resolv.h>, whose _res macro breaks Eigen's headers included after it.
 #include <httplib.h>
@@ -810,29 +811,24 @@ bool read_secret(const std::string& prompt, bool tty, std::string* out) {
   return got;
 }
 
-/// Writes `text` to `path` through a new file of mode 0600 beside it, renamed over it (the old
-/// file is never half written, the hashes are never readable by others). False on failure.
+/// Writes `text` to `path` through io::OutputFile (a temporary file beside it, fsynced and
+/// renamed over it: the old file is never half written), made 0600 before anything is written
+/// (the hashes are never readable by others). False, *why saying what failed, on failure.
 bool replace_file(const std::string& path, const std::string& text, std::string* why) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) {
-    *why = "cannot create " + tmp + ": " + std::strerror(errno);
+  try {
+    io::OutputFile f(path == "-" ? "./-" : path);  // a file named "-", not standard output
+    struct stat st {};
+    if (::fstat(f.fd(), &st) == 0 && S_ISREG(st.st_mode) && ::fchmod(f.fd(), 0600) != 0) {
+      *why = "cannot make " + path + " readable by its owner only: " + std::strerror(errno);
+      return false;
+    }
+    f.stream() << text;
+    f.commit();
+    return true;
+  } catch (const io::OutputError& e) {
+    *why = e.what();
     return false;
   }
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n <= 0) break;
-    done += static_cast<std::size_t>(n);
-  }
-  const bool ok = done == text.size() && ::fsync(fd) == 0;
-  ::close(fd);
-  if (!ok || ::rename(tmp.c_str(), path.c_str()) != 0) {
-    *why = "cannot write " + path + ": " + std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return false;
-  }
-  return true;
 }
 
 int run_dashboard_account(const AccountArgs& a) {
