@@ -238,6 +238,7 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
   svr.Get("/style.css", page(db::assets::kStyleCss, "text/css; charset=utf-8"));
   svr.Get("/vessel.html", page(db::assets::kVesselHtml, "text/html; charset=utf-8"));
   svr.Get("/vessel.js", page(db::assets::kVesselJs, "text/javascript; charset=utf-8"));
+  svr.Get("/common.js", page(db::assets::kCommonJs, "text/javascript; charset=utf-8"));
   if (db::vendor::kHaveCharts) {
     svr.Get("/uplot.js", page(db::vendor::kUplotJs, "text/javascript; charset=utf-8"));
     svr.Get("/uplot.css", page(db::vendor::kUplotCss, "text/css; charset=utf-8"));

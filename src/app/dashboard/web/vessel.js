@@ -6,27 +6,11 @@
 'use strict';
 
 const mmsi = Number(new URLSearchParams(location.search).get('mmsi'));
-const STATE_WORDS = {
-  'active-unacknowledged': 'ACTIVE, not acknowledged',
-  'active-acknowledged': 'active, acknowledged',
-  'rectified-unacknowledged': 'rectified, not acknowledged',
-  'normal': 'normal',
-};
 const haveCharts = typeof uPlot !== 'undefined';
 const charts = {};
 let data = null;     // the columns of /api/vessel
 let fetching = false;
 
-function el(tag, attrs, ...children) {
-  const e = document.createElement(tag);
-  for (const [k, v] of Object.entries(attrs || {})) {
-    if (k === 'class') e.className = v; else if (k.startsWith('data-')) e.setAttribute(k, v);
-    else e[k] = v;
-  }
-  for (const c of children) e.append(c instanceof Node ? c : document.createTextNode(String(c)));
-  return e;
-}
-function fixed(x, n) { return x === null || x === undefined ? '–' : Number(x).toFixed(n); }
 function problem(text) {
   const p = document.getElementById('problem');
   p.hidden = !text;
@@ -103,7 +87,7 @@ async function update() {
 function renderVessel(v) {
   const faults = document.querySelector('#faults tbody');
   faults.replaceChildren();
-  for (const sensor of ['accelerometer', 'gyro', 'unknown']) {
+  for (const sensor of SENSORS) {
     const r = v.sensors[sensor];
     const tr = el('tr', { 'data-sensor': sensor, 'data-presentation': r ? r.presentation : 'normal' });
     const cell = el('div', { class: 'cell alert-' + (r ? r.presentation : 'normal') },
