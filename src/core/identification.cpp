@@ -34,6 +34,8 @@ void IdentificationParams::validate() const {
   require(std::isfinite(lambda) && lambda > 0, "lambda", lambda, "must be a positive number");
   require(std::isfinite(warmup_time), "warmup_time", warmup_time, "must be a number");
   require(std::isfinite(max_gap) && max_gap > 0, "max_gap", max_gap, "must be positive");
+  require(std::isfinite(prefilter) && prefilter >= 0, "prefilter", prefilter,
+          "must be 0 (none) or a positive bandwidth");
   require(a0.allFinite(), "a0", a0.norm(), "must be finite");
   require(min_excitation >= 0 && min_excitation <= 1, "min_excitation", min_excitation,
           "must lie in [0, 1]");
@@ -70,6 +72,7 @@ const char* to_string(IdentStatus s) {
 Identifier::Identifier(const IdentificationParams& params, const Vec2& B, const SpeedParams& speed)
     : p_(params),
       B_(B),
+      prefilter_(params.method == IdentMethod::kPaper ? 0.0 : params.prefilter),
       f1_(params.eps1),
       f2_(params.eps2),
       speed_(speed),
@@ -163,10 +166,21 @@ void Identifier::restart_filters(const Sample& s) {
   est_.warming_up = true;
 }
 
-bool Identifier::update(const Sample& s, bool freeze) {
-  if (!finite(s)) return false;
+bool Identifier::update(const Sample& raw, bool freeze) {
+  if (!finite(raw)) return false;
   // Time must increase over every accepted sample, frozen ones included.
-  if (!std::isnan(t_last_) && !(s.t > t_last_)) return false;
+  if (!std::isnan(t_last_) && !(raw.t > t_last_)) return false;
+  // The prefilter runs on every accepted sample, frozen ones too, so that it is settled
+  // when identification resumes; a gap restarts it with the other filters.
+  if (std::isnan(t_last_) || raw.t - t_last_ > p_.max_gap) prefilter_.reset();
+  Sample s = raw;
+  if (prefilter_.enabled()) {
+    const InputPrefilter::Vec3 y =
+        prefilter_.step(raw.t - t_last_, InputPrefilter::Vec3(raw.v, raw.r, raw.delta));
+    s.v = y(0);
+    s.r = y(1);
+    s.delta = y(2);
+  }
   t_last_ = s.t;
   est_.t = s.t;
   const double sr = speed_.update(s);

@@ -274,6 +274,7 @@ class Loader {
         {"lambda", number_into(&id.lambda, {0, 10, "1/s"})},
         {"warmup_time", number_into(&id.warmup_time, {-1e6, kHour, "s (< 0: automatic)"})},
         {"max_gap", number_into(&id.max_gap, {0, kHour, "s"})},
+        {"prefilter", number_into(&id.prefilter, {0, 1e3, "rad/s (0: none)"})},
         {"curvature_correction", boolean_into(&id.curvature_correction)},
         {"cubic_correction", boolean_into(&id.cubic_correction)},
         {"min_excitation", number_into(&id.min_excitation, {0, 1, ""})},

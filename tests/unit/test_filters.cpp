@@ -277,5 +277,35 @@ TEST(FohLowPass, ErrorOrderOnASmoothInputIsTwoPlainThreeCurvedFourCubic) {
   EXPECT_LT(k1, 0.1 * c1);
 }
 
+TEST(InputPrefilter, StartsAtSteadyStateFollowsTheCascadeAndRestartsAfterReset) {
+  const double w = 0.3, h = 0.1;
+  InputPrefilter f(w);
+  ASSERT_TRUE(f.enabled());
+  // GIVEN a constant input: the output is that input from the first sample (no transient)
+  const InputPrefilter::Vec3 x0(0.2, -0.01, 0.05);
+  for (int k = 0; k < 5; ++k) EXPECT_EQ(f.step(h, x0), x0);
+  // WHEN the input steps by d and is held
+  const InputPrefilter::Vec3 d(1.0, -2.0, 0.5);
+  InputPrefilter::Vec3 y;
+  for (int k = 1; k <= 100; ++k) {
+    y = f.step(h, x0 + d);
+    // THEN each channel follows the sampled step response of w^2 / (p + w)^2 exactly (the
+    //   input is held over each step): 1 - (1 + w t) e^{-w t} at t = k h, up to the lag of
+    //   the second stage, which sees the first stage's output at the end of the step
+    const double a = -std::expm1(-w * h), e = 1.0 - a;
+    // Closed form of the two ZOH stages in cascade: 1 - e^k - k a e^k.
+    const double expect = 1.0 - std::pow(e, k) - k * a * std::pow(e, k);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR((y(i) - x0(i)) / d(i), expect, 1e-12) << k;
+  }
+  // AND after reset() the next sample is passed through as the new steady state
+  f.reset();
+  const InputPrefilter::Vec3 x1(-1.0, 3.0, 0.0);
+  EXPECT_EQ(f.step(h, x1), x1);
+  // AND a bandwidth of 0 passes every sample through
+  InputPrefilter off(0.0);
+  EXPECT_FALSE(off.enabled());
+  EXPECT_EQ(off.step(h, x0 + d), x0 + d);
+}
+
 }  // namespace
 }  // namespace usvfdi

@@ -1,6 +1,7 @@
 // Exact sampled first-order filters used by the identification thread.
 #pragma once
 
+#include <Eigen/Core>
 #include <cmath>
 
 namespace usvfdi {
@@ -123,6 +124,53 @@ class FohLowPass {
   double hp_ = -1.0;
   double w3_ = 0.0;
   bool w3_valid_ = false;
+};
+
+/// Identification's input prefilter: two cascaded first-order low-passes w/(p + w) on v, r
+/// and delta alike. A linear filter applied to every signal of x' = A x + B delta leaves
+/// that equation as it is, so the estimate is not biased; it only takes the INS noise and
+/// the first-order wave motion above w out of the equation error that decides arming
+/// (docs/design.md, "The input prefilter"). Each stage is exact for an input held over the
+/// step; the first sample after reset() sets both stages to steady state, so a restart adds
+/// no transient of its own.
+class InputPrefilter {
+ public:
+  using Vec3 = Eigen::Matrix<double, 3, 1>;
+
+  /// w: bandwidth [rad/s]; 0 passes the inputs through.
+  explicit InputPrefilter(double w = 0.0) : w_(w) {}
+
+  bool enabled() const { return w_ > 0.0; }
+  double bandwidth() const { return w_; }
+  /// The next step() starts again at steady state.
+  void reset() { started_ = false; }
+
+  /// Filters x over the step dt [s] since the previous call (ignored after a reset);
+  /// returns the output of the second stage.
+  Vec3 step(double dt, const Vec3& x) {
+    if (!enabled()) return x;
+    if (!started_) {
+      s1_ = x;
+      s2_ = x;
+      started_ = true;
+      return s2_;
+    }
+    if (!(std::abs(dt - dt_) <= 1e-9 * dt)) {
+      dt_ = dt;
+      alpha_ = -std::expm1(-w_ * dt);
+    }
+    s1_ += alpha_ * (x - s1_);
+    s2_ += alpha_ * (s1_ - s2_);
+    return s2_;
+  }
+
+ private:
+  double w_;
+  double dt_ = -1.0;
+  double alpha_ = 0.0;
+  bool started_ = false;
+  Vec3 s1_ = Vec3::Zero();
+  Vec3 s2_ = Vec3::Zero();
 };
 
 }  // namespace usvfdi
