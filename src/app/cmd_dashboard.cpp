@@ -78,21 +78,32 @@ struct DashboardArgs {
 /// What the HTTP threads share with the DDS thread: the latest board and the acks asked for.
 class Hub {
  public:
-  void publish(std::string board) {
+  void publish(db::BoardFrame frame) {
     {
       std::lock_guard<std::mutex> l(m_);
-      board_ = std::move(board);
+      board_ = std::move(frame.full);
       ++version_;
+      deltas_.emplace_back(version_, std::move(frame.delta));
+      while (deltas_.size() > kDeltas) deltas_.pop_front();
     }
     cv_.notify_all();
   }
-  /// Waits up to `timeout` for a board newer than *seen; true and that board if there is one.
+  /// Waits up to `timeout` for a board newer than *seen; true and the server-sent events that
+  /// bring a page from board *seen to the newest: the deltas since, or the whole board when
+  /// the page has none yet or is further behind than the deltas kept.
   bool next(std::uint64_t* seen, std::string* out, std::chrono::milliseconds timeout) {
     std::unique_lock<std::mutex> l(m_);
     cv_.wait_for(l, timeout, [&] { return stop_ || version_ > *seen; });
     if (stop_ || version_ <= *seen) return false;
+    out->clear();
+    if (*seen == 0 || deltas_.empty() || deltas_.front().first > *seen + 1) {
+      *out = "data: " + board_ + "\n\n";
+    } else {
+      for (const auto& [version, delta] : deltas_) {
+        if (version > *seen) *out += "data: " + delta + "\n\n";
+      }
+    }
     *seen = version_;
-    *out = board_;
     return true;
   }
   std::string current() {
@@ -152,6 +163,8 @@ class Hub {
   std::mutex m_;
   std::condition_variable cv_;
   std::string board_ = "{}";
+  std::deque<std::pair<std::uint64_t, std::string>> deltas_;  ///< (version, delta), newest last
+  static constexpr std::size_t kDeltas = 16;
   std::string metrics_;
   std::uint64_t version_ = 0;
   bool stop_ = false;
@@ -311,10 +324,9 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
     res.set_chunked_content_provider(
         "text/event-stream",
         [&hub, seen](std::size_t, httplib::DataSink& sink) {
-          std::string board;
-          if (hub.next(seen.get(), &board, std::chrono::milliseconds(2000))) {
-            const std::string msg = "data: " + board + "\n\n";
-            return sink.write(msg.data(), msg.size());
+          std::string msgs;
+          if (hub.next(seen.get(), &msgs, std::chrono::milliseconds(2000))) {
+            return sink.write(msgs.data(), msgs.size());
           }
           if (hub.stopped()) {
             sink.done();
@@ -617,17 +629,10 @@ db::BoardInput board_input(const FleetView& view) {
   return in;
 }
 
-std::string make_board(const db::BoardInput& in, const db::EventHistory& events, const Acks& acks,
-                       bool can_ack) {
-  json j = db::board_json(in, events, acks.outcomes(), wall_now());
-  j["can_ack"] = can_ack;
-  return j.dump(-1, ' ', false, json::error_handler_t::replace);
-}
-
 /// The DDS thread's loop: the fleet view, the acks, the board; until a stop signal or the
 /// credentials expire. Returns the exit code.
 int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& events, Acks& acks,
-          Hub& hub, const CredentialExpiry& expiry) {
+          Hub& hub, db::BoardFramer& framer, const CredentialExpiry& expiry) {
   double last_board = mono_now(), last_metrics = last_board;
   for (;;) {
     bool changed = view.poll(0.1);
@@ -638,7 +643,7 @@ int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& event
     if (board || metrics) {
       const db::BoardInput in = board_input(view);
       if (board) {
-        hub.publish(make_board(in, events, acks, !a.read_only));
+        hub.publish(framer.frame(in, events, acks.outcomes(), wall_now(), !a.read_only));
         last_board = now;
       }
       // The metrics once a second (a scrape is seconds apart), not on every change.
@@ -716,9 +721,10 @@ int run_dashboard(DashboardArgs& a) {
     acks.on_event(r);
   });
   Hub hub;
+  db::BoardFramer framer;
   {
     const db::BoardInput in = board_input(*view);
-    hub.publish(make_board(in, events, acks, !a.read_only));
+    hub.publish(framer.frame(in, events, acks.outcomes(), wall_now(), !a.read_only));
     hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
   }
 
@@ -757,7 +763,7 @@ int run_dashboard(DashboardArgs& a) {
                     : std::string("no sign-in"),
                ctx->config().domain_id);
   try {
-    rc = serve(a, *view, events, acks, hub, expiry);
+    rc = serve(a, *view, events, acks, hub, framer, expiry);
   } catch (const std::exception& e) {
     spdlog::error("dashboard: {}", e.what());
     rc = kExitFailure;

@@ -284,6 +284,16 @@ test('a board of 100 emulated vessels loads and stays responsive', async () => {
   });
   assert.equal(new Set(drawn).size, drawn.length, 'no event drawn twice');
   assert.ok(drawn.length > 10 && drawn.length <= 1000, `${drawn.length} events drawn`);
+  // After the first board the page is sent only what changed (deltas): the board it has put
+  // together is the dashboard's own (ages aside), at some moment while updates keep arriving.
+  const same = await waitFor('the page\'s board assembled from deltas equal to /api/board',
+    () => page.evaluate(async () => {
+      const bare = (b) => JSON.stringify({ vessels: b.vessels, events: b.events, acks: b.acks },
+        (k, x) => (k === 'age_s' || k === 'heard_age_s' ? undefined : x));
+      const server = await (await fetch('/api/board')).json();
+      return bare(server) === bare(board) ? server.vessels.length : 0;
+    }), 30);
+  assert.equal(same, 100);
   // The audible signal (IEC 62923): off until the operator switches it on; then sounding while
   // an alert is active and unacknowledged (the tab's title counts them); Silence stops it.
   assert.equal(await page.getAttribute('body', 'data-sounding'), 'false', 'no sound before a click');

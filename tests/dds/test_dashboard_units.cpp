@@ -5,6 +5,9 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "dashboard/board.hpp"
 #include "dashboard/metrics.hpp"
@@ -83,6 +86,100 @@ TEST(DashboardBoard, TheBoardHasEveryVesselHeardLatchedOrOnTheRoster) {
   EXPECT_TRUE(j["vessels"][2]["heard_age_s"].is_null());
   EXPECT_EQ(j["acks"][0]["reason"], "stale sequence");
   EXPECT_NO_THROW(nlohmann::json::parse(j.dump()));
+}
+
+/// What the page does with a delta (applyDelta in web/app.js), in C++.
+nlohmann::json apply_delta(nlohmann::json board, const nlohmann::json& d) {
+  std::map<std::uint32_t, nlohmann::json> vessels;
+  for (const auto& v : board["vessels"]) vessels[v["mmsi"].get<std::uint32_t>()] = v;
+  for (const auto& m : d["removed"]) vessels.erase(m.get<std::uint32_t>());
+  for (const auto& v : d["vessels"]) vessels[v["mmsi"].get<std::uint32_t>()] = v;
+  board["vessels"] = nlohmann::json::array();
+  for (auto& [m, v] : vessels) {
+    const std::string key = std::to_string(m);
+    if (d["heard_age"].contains(key)) v["heard_age_s"] = d["heard_age"][key];
+    for (auto& [s, r] : v["sensors"].items()) {
+      r["age_s"] = d["now"].get<double>() - r["written"].get<double>();
+    }
+    board["vessels"].push_back(v);
+  }
+  nlohmann::json events = d["events"];
+  for (const auto& e : board["events"]) events.push_back(e);
+  while (events.size() > d["event_capacity"].get<std::size_t>()) events.erase(events.size() - 1);
+  board["events"] = events;
+  for (const char* k : {"now", "silent_after", "conflicts", "acks", "can_ack"}) board[k] = d[k];
+  return board;
+}
+
+/// The board without the events' ages (the page does not show them, and a delta does not move
+/// them on).
+nlohmann::json without_event_ages(nlohmann::json j) {
+  for (auto& e : j["events"]) e.erase("age_s");
+  return j;
+}
+
+TEST(DashboardBoard, DeltasCarryOnlyWhatChangedAndApplyToTheNextBoard) {
+  BoardFramer framer;
+  EventHistory h(3);
+  std::deque<AckOutcome> acks;
+  BoardInput in;
+  for (std::uint32_t m = 1; m <= 4; ++m) {
+    in.heard_age[m] = 0.1 * m;
+    in.silent[m] = false;
+  }
+  const Row g1 = row(2, Sensor::kGyro, FaultState::kRaised, 1, 90.0);
+  in.rows[{2, static_cast<int>(Sensor::kGyro)}] = g1;
+  h.add(g1);
+  // GIVEN a first frame: the whole board, and a delta that carries every vessel
+  BoardFrame f = framer.frame(in, h, acks, 100.0, true);
+  nlohmann::json board = nlohmann::json::parse(f.full);
+  nlohmann::json d = nlohmann::json::parse(f.delta);
+  EXPECT_EQ(board["vessels"].size(), 4u);
+  EXPECT_TRUE(board["can_ack"].get<bool>());
+  EXPECT_EQ(d["vessels"].size(), 4u);
+  EXPECT_EQ(d["events"].size(), 1u);
+  // WHEN only time passes (every vessel heard again, nothing latched changes)
+  for (std::uint32_t m = 1; m <= 4; ++m) in.heard_age[m] = 0.2 * m;
+  f = framer.frame(in, h, acks, 101.0, true);
+  d = nlohmann::json::parse(f.delta);
+  // THEN the delta carries no vessel and no event, only the ages
+  EXPECT_EQ(d["vessels"].size(), 0u) << d.dump();
+  EXPECT_EQ(d["events"].size(), 0u);
+  EXPECT_DOUBLE_EQ(d["heard_age"]["3"].get<double>(), 0.6);
+  EXPECT_LT(f.delta.size(), f.full.size() / 3);
+  board = apply_delta(board, d);
+  EXPECT_EQ(without_event_ages(board), without_event_ages(nlohmann::json::parse(f.full)));
+  // WHEN vessel 3 raises, vessel 2's fault clears, vessel 4 leaves the board and 5 joins, with
+  //   three events (one more than the history's capacity of 3 holds with the one before)
+  const Row a3 = row(3, Sensor::kAccelerometer, FaultState::kRaised, 1, 100.5);
+  const Row g2 = row(2, Sensor::kGyro, FaultState::kClearedUnacknowledged, 2, 100.6);
+  const Row g5 = row(5, Sensor::kGyro, FaultState::kRaised, 1, 100.7);
+  in.rows[{3, static_cast<int>(Sensor::kAccelerometer)}] = a3;
+  in.rows[{2, static_cast<int>(Sensor::kGyro)}] = g2;
+  in.rows[{5, static_cast<int>(Sensor::kGyro)}] = g5;
+  in.heard_age.erase(4);
+  in.silent.erase(4);
+  in.heard_age[5] = 0.0;
+  in.silent[5] = false;
+  for (const Row& r : {a3, g2, g5}) h.add(r);
+  acks.push_back(AckOutcome{2, Sensor::kGyro, 1, "alice", 100.2, "accepted", ""});
+  f = framer.frame(in, h, acks, 102.0, true);
+  d = nlohmann::json::parse(f.delta);
+  // THEN the delta carries vessels 2, 3 and 5 whole, 4 as removed, the three events newest
+  //   first, and the acknowledgements
+  std::vector<std::uint32_t> carried;
+  for (const auto& v : d["vessels"]) carried.push_back(v["mmsi"].get<std::uint32_t>());
+  EXPECT_EQ(carried, (std::vector<std::uint32_t>{2, 3, 5}));
+  EXPECT_EQ(d["removed"], nlohmann::json::array({4}));
+  ASSERT_EQ(d["events"].size(), 3u);
+  EXPECT_EQ(d["events"][0]["mmsi"], 5);
+  EXPECT_EQ(d["events"][2]["mmsi"], 3);
+  EXPECT_EQ(d["acks"][0]["operator"], "alice");
+  // AND applied to the page's board it gives the whole board of this frame
+  board = apply_delta(board, d);
+  EXPECT_EQ(without_event_ages(board), without_event_ages(nlohmann::json::parse(f.full)))
+      << board.dump() << "\n"
+      << f.full;
 }
 
 TEST(DashboardMetrics, TheFleetIsExposedInPrometheusTextForm) {

@@ -1,7 +1,10 @@
 #include "board.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "usv_fdi/core/text.hpp"
 #include "usv_fdi/pipeline/pipeline.hpp"
@@ -90,6 +93,7 @@ void EventHistory::add(const Row& r) {
   }
   last_state_[key] = {r.ev.state, r.ev.detection_time};
   events_.push_front(r);
+  ++added_;
   while (events_.size() > capacity_) events_.pop_back();
 }
 
@@ -144,9 +148,12 @@ bool parse_ack_body(const std::string& body, AckWork* out, std::string* why) {
   return true;
 }
 
-json EventHistory::to_json(double now) const {
+json EventHistory::to_json(double now) const { return newest_json(events_.size(), now); }
+
+json EventHistory::newest_json(std::size_t n, double now) const {
   json out = json::array();
-  for (const Row& r : events_) out.push_back(row_json(r, now));
+  for (std::size_t i = 0; i < n && i < events_.size(); ++i)
+    out.push_back(row_json(events_[i], now));
   return out;
 }
 
@@ -159,40 +166,108 @@ std::set<std::uint32_t> board_vessels(const BoardInput& in) {
   return mmsis;
 }
 
-json board_json(const BoardInput& in, const EventHistory& events,
-                const std::deque<AckOutcome>& acks, double now) {
-  json vessels = json::array();
+namespace {
+
+/// Every vessel's entry on the board, by MMSI (rows grouped in one pass, not per vessel).
+std::vector<std::pair<std::uint32_t, json>> vessel_entries(const BoardInput& in, double now) {
+  std::map<std::uint32_t, json> sensors;
+  for (const auto& [key, row] : in.rows) {
+    sensors[key.first][to_string(row.ev.sensor)] = row_json(row, now);
+  }
+  const std::set<std::uint32_t> never(in.roster_never_heard.begin(), in.roster_never_heard.end());
+  std::vector<std::pair<std::uint32_t, json>> out;
   for (const std::uint32_t m : board_vessels(in)) {
     json v{{"mmsi", m}};
-    json sensors = json::object();
-    for (const auto& [key, row] : in.rows) {
-      if (key.first == m) sensors[to_string(row.ev.sensor)] = row_json(row, now);
-    }
-    v["sensors"] = sensors;
+    const auto se = sensors.find(m);
+    v["sensors"] = se == sensors.end() ? json::object() : std::move(se->second);
     const auto st = in.statuses.find(m);
     v["status"] = st == in.statuses.end() ? json(nullptr) : status_json(st->second);
     const auto age = in.heard_age.find(m);
     v["heard_age_s"] = age == in.heard_age.end() ? json(nullptr) : num(age->second);
     const auto sil = in.silent.find(m);
     v["silent"] = sil != in.silent.end() && sil->second;
-    bool never = false;
-    for (const std::uint32_t r : in.roster_never_heard) never = never || r == m;
-    v["never_heard"] = never;
-    vessels.push_back(v);
+    v["never_heard"] = never.count(m) > 0;
+    out.emplace_back(m, std::move(v));
   }
-  json ack_list = json::array();
+  return out;
+}
+
+json ack_list_json(const std::deque<AckOutcome>& acks) {
+  json out = json::array();
   for (const AckOutcome& a : acks) {
-    ack_list.push_back(json{{"mmsi", a.mmsi},
-                            {"sensor", to_string(a.sensor)},
-                            {"sequence", a.sequence},
-                            {"operator", a.operator_id},
-                            {"sent", num(a.sent)},
-                            {"state", a.state},
-                            {"reason", a.reason}});
+    out.push_back(json{{"mmsi", a.mmsi},
+                       {"sensor", to_string(a.sensor)},
+                       {"sequence", a.sequence},
+                       {"operator", a.operator_id},
+                       {"sent", num(a.sent)},
+                       {"state", a.state},
+                       {"reason", a.reason}});
   }
-  return json{
-      {"now", num(now)},    {"silent_after", num(in.silent_after)}, {"conflicts", in.conflicts},
-      {"vessels", vessels}, {"events", events.to_json(now)},        {"acks", ack_list}};
+  return out;
+}
+
+std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+}  // namespace
+
+json board_json(const BoardInput& in, const EventHistory& events,
+                const std::deque<AckOutcome>& acks, double now) {
+  json vessels = json::array();
+  for (auto& [m, v] : vessel_entries(in, now)) vessels.push_back(std::move(v));
+  return json{{"now", num(now)},
+              {"silent_after", num(in.silent_after)},
+              {"conflicts", in.conflicts},
+              {"vessels", std::move(vessels)},
+              {"events", events.to_json(now)},
+              {"acks", ack_list_json(acks)}};
+}
+
+BoardFrame BoardFramer::frame(const BoardInput& in, const EventHistory& events,
+                              const std::deque<AckOutcome>& acks, double now, bool can_ack) {
+  json vessels = json::array(), changed = json::array(), removed = json::array();
+  json ages = json::object();
+  std::map<std::uint32_t, std::string> keys;
+  for (auto& [m, v] : vessel_entries(in, now)) {
+    // what the entry says besides its ages, which move on with every board
+    json bare = v;
+    bare.erase("heard_age_s");
+    for (auto& [sensor, row] : bare["sensors"].items()) row.erase("age_s");
+    std::string key = dump(bare);
+    const auto was = keys_.find(m);
+    if (was == keys_.end() || was->second != key) changed.push_back(v);
+    keys.emplace(m, std::move(key));
+    const auto age = in.heard_age.find(m);
+    if (age != in.heard_age.end()) ages[std::to_string(m)] = num(age->second);
+    vessels.push_back(std::move(v));
+  }
+  for (const auto& [m, key] : keys_) {
+    if (keys.count(m) == 0) removed.push_back(m);
+  }
+  keys_.swap(keys);
+  const std::uint64_t added = events.added();
+  const std::size_t fresh =
+      static_cast<std::size_t>(std::min<std::uint64_t>(added - events_framed_, events.size()));
+  events_framed_ = added;
+  const json acks_j = ack_list_json(acks);
+  json full{{"now", num(now)},
+            {"silent_after", num(in.silent_after)},
+            {"conflicts", in.conflicts},
+            {"vessels", std::move(vessels)},
+            {"events", events.to_json(now)},
+            {"acks", acks_j},
+            {"can_ack", can_ack}};
+  json delta{{"delta", true},
+             {"now", num(now)},
+             {"silent_after", num(in.silent_after)},
+             {"conflicts", in.conflicts},
+             {"vessels", std::move(changed)},
+             {"removed", std::move(removed)},
+             {"events", events.newest_json(fresh, now)},
+             {"event_capacity", events.capacity()},
+             {"heard_age", std::move(ages)},
+             {"acks", acks_j},
+             {"can_ack", can_ack}};
+  return BoardFrame{dump(full), dump(delta)};
 }
 
 bool acknowledged_by(const std::string& message, const std::string& operator_id) {

@@ -37,7 +37,12 @@ class EventHistory {
   /// instance (a late joiner's copy of the latched state, or a writer's repeat).
   void add(const Row& r);
   nlohmann::json to_json(double now) const;
+  /// The `n` newest events (at most size()), newest first.
+  nlohmann::json newest_json(std::size_t n, double now) const;
   std::size_t size() const { return events_.size(); }
+  std::size_t capacity() const { return capacity_; }
+  /// Events recorded since the start (the oldest leave the history at capacity).
+  std::uint64_t added() const { return added_; }
   /// Raises recorded per instance (vessel, sensor), since the start (not bounded by capacity):
   /// an event in the raised state after one in another state, or with another detection time
   /// (a raise whose clearing was not seen); a refined kind (the same raise republished with
@@ -46,6 +51,7 @@ class EventHistory {
 
  private:
   std::size_t capacity_;
+  std::uint64_t added_ = 0;
   std::deque<Row> events_;
   std::map<RowKey, std::uint64_t> last_sequence_;
   std::map<RowKey, std::uint64_t> raises_;
@@ -93,5 +99,28 @@ struct BoardInput {
 std::set<std::uint32_t> board_vessels(const BoardInput& in);
 nlohmann::json board_json(const BoardInput& in, const EventHistory& events,
                           const std::deque<AckOutcome>& acks, double now);
+
+/// One board for the live pages: whole, and as the change from the board framed before it.
+struct BoardFrame {
+  std::string full;  ///< board_json plus can_ack (GET /api/board; a page's first message)
+  /// {"delta": true, ...}: what turns the previous full board into this one: the vessels whose
+  /// entry changed other than in its ages (whole), the MMSIs gone ("removed"), the events added
+  /// since (newest first; "event_capacity": how many the history keeps), every vessel's heard
+  /// age ("heard_age", by MMSI), and now, silent_after, conflicts, acks and can_ack as in the
+  /// full board. A sensor's age_s is now - written.
+  std::string delta;
+};
+
+/// Frames successive boards; remembers each vessel's entry (without its ages) and the events
+/// already framed. A board of 1000 vessels is ~500 kB; a change touches a few.
+class BoardFramer {
+ public:
+  BoardFrame frame(const BoardInput& in, const EventHistory& events,
+                   const std::deque<AckOutcome>& acks, double now, bool can_ack);
+
+ private:
+  std::map<std::uint32_t, std::string> keys_;  ///< each vessel's entry without ages, dumped
+  std::uint64_t events_framed_ = 0;            ///< EventHistory::added() at the last frame
+};
 
 }  // namespace usvfdi::app::dashboard

@@ -1,11 +1,13 @@
 // usv-fdi dashboard: renders the fleet board the dashboard pushes (server-sent events on
-// /api/stream, the whole board on every change and once a second for the ages) and posts
-// acknowledgements to /api/ack. No framework, no network beyond the dashboard itself.
+// /api/stream: the whole board first, then on every change and once a second the change since
+// the board before) and posts acknowledgements to /api/ack. No framework, no network beyond
+// the dashboard itself.
 'use strict';
 
 let board = null;
 let me = { name: null, role: 'observer', can_ack: false };  // /api/me: the signed-in account
 const sent = new Set();  // mmsi/sensor/sequence acknowledged from this page
+let changed = null;      // MMSIs whose entry changed since the last drawing (null: all)
 let holding = false;     // a pointer is down: the board waits, so that a click is not lost
 let stale = false;       // a board arrived while holding
 
@@ -55,14 +57,22 @@ function detector(s) {
   return parts.join(' · ');
 }
 
-// The board is pushed whole on every change; the page rebuilds only the rows that changed (a
-// board of 1000 vessels and 1000 events would otherwise be rebuilt several times a second).
+// The page rebuilds only the rows that changed (a board of 1000 vessels and 1000 events would
+// otherwise be rebuilt several times a second); the others only move their ages on.
 const shownRows = new Map();    // mmsi -> { key, tr }: the board's rows as drawn
 const shownEvents = new Map();  // event key -> tr: the event list's rows as drawn
 let shownFilter = null;
 
 function heardText(v) {
   return v.never_heard ? 'never heard' : (v.silent ? 'SILENT ' : '') + age(v.heard_age_s) + ' ago';
+}
+
+// What a row shows besides its ages: the sensors' cells, the detector's words, the liveness (a
+// status every second that changes none of them redraws nothing).
+function shownEntry(v) {
+  const sensors = SENSORS.map((s) => JSON.stringify(v.sensors[s] || null,
+    (k, x) => (k === 'age_s' ? undefined : x)));
+  return JSON.stringify([v.mmsi, v.silent, v.never_heard, detector(v.status), sensors]);
 }
 
 function renderBoard() {
@@ -73,9 +83,9 @@ function renderBoard() {
     seen.add(v.mmsi);
     // what the row shows besides its ages: the vessel, the buttons this page may show
     const mine = [...sent].filter((k) => k.startsWith(v.mmsi + '/')).join();
-    const key = JSON.stringify(v, (k, x) => (k === 'heard_age_s' || k === 'age_s' ? undefined : x)) +
-      `|${board.can_ack}|${me.can_ack}|${mine}`;
     let row = shownRows.get(v.mmsi);
+    const entry = row && changed && !changed.has(v.mmsi) ? row.entry : shownEntry(v);
+    const key = entry + `|${board.can_ack}|${me.can_ack}|${mine}`;
     if (!row || row.key !== key) {
       const tr = el('tr', { 'data-mmsi': v.mmsi, class: v.silent || v.never_heard ? 'silent' : '' });
       tr.append(el('td', { class: 'vessel' },
@@ -84,7 +94,7 @@ function renderBoard() {
       tr.append(el('td', { class: 'detector' }, detector(v.status)));
       for (const s of SENSORS) tr.append(sensorCell(v, s));
       if (row) row.tr.replaceWith(tr);
-      row = { key, tr };
+      row = { key, entry, tr };
       shownRows.set(v.mmsi, row);
     } else {
       // the same row: only its ages move on
@@ -106,6 +116,7 @@ function renderBoard() {
   // the rows in the board's order (moved, not rebuilt, when a vessel comes or goes)
   const now = [...body.children];
   if (now.length !== order.length || order.some((tr, k) => now[k] !== tr)) body.replaceChildren(...order);
+  changed = new Set();
   const active = board.vessels.reduce((n, v) => n + SENSORS.filter(
     (s) => v.sensors[s] && v.sensors[s].presentation === 'active-unacknowledged').length, 0);
   const silent = board.vessels.filter((v) => v.silent).length;
@@ -269,12 +280,41 @@ async function acknowledge(mmsi, sensor, sequence, button) {
   out.className = r.ok ? 'accepted' : 'refused';
 }
 
+// A delta (BoardFrame::delta in src/app/dashboard/board.hpp): the vessels whose entry changed
+// come whole; the others keep theirs, with the heard ages given and every sensor's age from
+// its written time; the events added go on top, as many kept as the dashboard keeps.
+function applyDelta(d) {
+  const vessels = new Map(board.vessels.map((v) => [v.mmsi, v]));
+  for (const m of d.removed) vessels.delete(m);
+  for (const v of d.vessels) {
+    vessels.set(v.mmsi, v);
+    if (changed) changed.add(v.mmsi);
+  }
+  for (const v of vessels.values()) {
+    const heard = d.heard_age[v.mmsi];
+    if (heard !== undefined) v.heard_age_s = heard;
+    for (const s of SENSORS) {
+      const r = v.sensors[s];
+      if (r) r.age_s = d.now - r.written;
+    }
+  }
+  board.vessels = [...vessels.values()].sort((a, b) => a.mmsi - b.mmsi);
+  board.events = d.events.concat(board.events).slice(0, d.event_capacity);
+  for (const k of ['now', 'silent_after', 'conflicts', 'acks', 'can_ack']) board[k] = d[k];
+}
+
 function connect() {
   const link = document.getElementById('link');
   const es = new EventSource('/api/stream');
   es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
   es.onmessage = (m) => {
-    board = JSON.parse(m.data);
+    const msg = JSON.parse(m.data);
+    if (msg.delta && board) {
+      applyDelta(msg);
+    } else {
+      board = msg;
+      changed = null;
+    }
     if (holding) stale = true; else render();
   };
   es.onerror = () => { link.textContent = 'reconnecting'; link.className = 'link down'; };

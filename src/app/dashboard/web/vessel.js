@@ -120,9 +120,17 @@ function connect() {
   const link = document.getElementById('link');
   const es = new EventSource('/api/stream');
   es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
+  let v = null;  // this vessel's entry on the board
   es.onmessage = (m) => {
     const board = JSON.parse(m.data);
-    const v = board.vessels.find((x) => x.mmsi === mmsi);
+    const mine = board.vessels.find((x) => x.mmsi === mmsi);
+    if (!board.delta || mine) {
+      v = mine || null;  // the whole board, or this vessel's entry changed
+    } else if (board.removed.includes(mmsi)) {
+      v = null;
+    } else if (v && board.heard_age[mmsi] !== undefined) {
+      v.heard_age_s = board.heard_age[mmsi];  // a change elsewhere: only the age moves on
+    }
     document.getElementById('summary').textContent = v ? '' : 'not on the board';
     if (v) renderVessel(v);
     update();
