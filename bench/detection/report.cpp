@@ -54,7 +54,7 @@ void write_method_summary(std::ostream& o, const MethodSummary& m) {
   o << "{\"faults\": " << m.faults << ", \"detected\": " << m.detected
     << ", \"isolated\": " << m.isolated << ", \"armed_at_onset\": " << m.armed_at_onset
     << ", \"detected_when_armed\": " << m.detected_armed << ", \"recovered\": " << m.recovered
-    << ", \"false_alarms\": " << m.false_alarms
+    << ", \"held\": " << m.held << ", \"false_alarms\": " << m.false_alarms
     << ", \"healthy_hours\": " << json_num(m.healthy_hours)
     << ", \"healthy_armed_hours\": " << json_num(m.healthy_armed_hours)
     << ", \"false_alarms_per_hour\": " << json_num(m.fa_per_hour())
@@ -106,7 +106,8 @@ void write_method_result(std::ostream& o, const Case& c, const MethodResult& m) 
       << ", \"isolated\": " << (f.isolated ? "true" : "false")
       << ", \"raised_sensor\": " << json_str(f.detected ? to_string(f.raised_sensor) : "")
       << ", \"delay\": " << json_num(f.delay)
-      << ", \"recovery_delay\": " << json_num(f.recovery_delay);
+      << ", \"recovery_delay\": " << json_num(f.recovery_delay)
+      << ", \"held\": " << (f.held ? "true" : "false") << ", \"shown\": " << json_num(f.shown);
   }
   o << "}";
 }
@@ -199,6 +200,7 @@ std::vector<BreakdownRow> breakdown(const std::vector<Case>& cases,
         ++row.m[k][0];
         if (s.isolated) ++row.m[k][1];
         if (s.delay <= BreakdownRow::kEarly) ++row.m[k][2];
+        if (s.held) ++row.m[k][3];
       }
     }
   }
@@ -224,7 +226,9 @@ std::string to_breakdown(const std::vector<BreakdownRow>& rows) {
   std::ostringstream o;
   o << "Where the faults are found and missed, over every table (detected / isolated / "
        "detected within "
-    << fmt("%.0f", BreakdownRow::kEarly) << " s of the onset, of the faults):\n\n";
+    << fmt("%.0f", BreakdownRow::kEarly)
+    << " s of the onset / raised on the faulty sensor until the fault's end, of the "
+       "faults):\n\n";
   o << "| data | sensor | kind | faults |";
   for (int k = 0; k < kMethods; ++k) o << " " << method_name(k) << " |";
   o << "\n|---|---|---|---|";
@@ -234,7 +238,8 @@ std::string to_breakdown(const std::vector<BreakdownRow>& rows) {
     o << "| " << r.data << " | " << to_string(r.sensor) << " | " << to_string(r.kind) << " | "
       << r.faults << " |";
     for (int k = 0; k < kMethods; ++k) {
-      o << " " << r.m[k][0] << " / " << r.m[k][1] << " / " << r.m[k][2] << " |";
+      o << " " << r.m[k][0] << " / " << r.m[k][1] << " / " << r.m[k][2] << " / " << r.m[k][3]
+        << " |";
     }
     o << "\n";
   }
@@ -255,9 +260,9 @@ std::string to_markdown(const std::vector<TableSummary>& tables, const std::stri
     if (!t.note.empty()) o << t.note << ".\n\n";
     o << "| method | detected | isolated | detected when armed at onset | false alarms "
          "(healthy h) | per healthy h | per armed healthy h (h) | delay median / p95 [s] | "
-         "recovery median / p95 [s] "
+         "raised until the end | recovery median / p95 [s] "
          "(cleared) | armed (runs) | arming median / max [s] | Â error median / p95 |\n";
-    o << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    o << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (int k = 0; k < kMethods; ++k) {
       const MethodSummary& m = t.m[k];
       o << "| " << method_name(k) << " | " << pct(m.detected, m.faults) << " | "
@@ -265,11 +270,11 @@ std::string to_markdown(const std::vector<TableSummary>& tables, const std::stri
         << m.false_alarms << " (" << fmt("%.1f", m.healthy_hours) << ") | "
         << fmt("%.2f", m.fa_per_hour()) << " | " << fmt("%.2f", m.fa_per_armed_hour()) << " ("
         << fmt("%.1f", m.healthy_armed_hours) << ") | " << fmt("%.2f", m.delay_median) << " / "
-        << fmt("%.2f", m.delay_p95) << " | " << fmt("%.1f", m.recovery_median) << " / "
-        << fmt("%.1f", m.recovery_p95) << " (" << m.recovered << "/" << m.detected << ") | "
-        << m.armed_runs << "/" << m.runs << " | " << fmt("%.0f", m.arming_median) << " / "
-        << fmt("%.0f", m.arming_max) << " | " << fmt("%.3f", m.a_error_median) << " / "
-        << fmt("%.3f", m.a_error_p95) << " |\n";
+        << fmt("%.2f", m.delay_p95) << " | " << pct(m.held, m.faults) << " | "
+        << fmt("%.1f", m.recovery_median) << " / " << fmt("%.1f", m.recovery_p95) << " ("
+        << m.recovered << "/" << m.detected << ") | " << m.armed_runs << "/" << m.runs << " | "
+        << fmt("%.0f", m.arming_median) << " / " << fmt("%.0f", m.arming_max) << " | "
+        << fmt("%.3f", m.a_error_median) << " / " << fmt("%.3f", m.a_error_p95) << " |\n";
     }
     bool any = false;
     for (const MethodSummary& m : t.m) any = any || m.faults > 0;

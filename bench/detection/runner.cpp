@@ -581,6 +581,7 @@ void add_fault_scores(const std::vector<FaultScore>& faults, MethodSummary* m, A
       if (kind < kinds.size()) ++m->per_kind[kind][2];
     }
     a->delay.push_back(f.delay);
+    if (f.held) ++m->held;
     if (f.recovered) {
       ++m->recovered;
       a->recovery.push_back(f.recovery_delay);

@@ -130,6 +130,7 @@ CaseResult run_case(const Case& c, std::size_t index, const EngineConfig& engine
 struct MethodSummary {
   int faults = 0, detected = 0, isolated = 0, armed_at_onset = 0, detected_armed = 0;
   int recovered = 0;
+  int held = 0;  ///< faults raised on their sensor until their end (FaultScore::held)
   int false_alarms = 0;
   double healthy_hours = 0.0, healthy_armed_hours = 0.0;
   double delay_median = kNaN, delay_p95 = kNaN;
@@ -177,8 +178,9 @@ struct BreakdownRow {
   Sensor sensor = Sensor::kUnknown;
   FaultKind kind = FaultKind::kUnknown;
   int faults = 0;
-  /// Per method: detected, isolated, detected within kEarly of the onset.
-  std::array<std::array<int, 3>, kMethods> m{};
+  /// Per method: detected, isolated, detected within kEarly of the onset, raised on the
+  /// faulty sensor until the fault's end (FaultScore::held).
+  std::array<std::array<int, 4>, kMethods> m{};
   static constexpr double kEarly = 15.0;  ///< [s]: a 10 sigma / 30 s ramp is at 5 sigma
 };
 /// The kind of data a case is: "calm" (course/calm), "sea 3, MEMS" (voyage/sea3/mems), or

@@ -127,6 +127,28 @@ void score_recovery(const std::vector<Alarm>& alarms, double limit, FaultScore* 
   }
 }
 
+/// How long the faulty sensor was shown raised during the fault, and whether it stayed raised
+/// from its first raise in the fault to the fault's end.
+void score_shown(const std::vector<Alarm>& alarms, FaultScore* fs) {
+  const InjectedFault& f = fs->fault;
+  bool raised = false, first_seen = false, dropped = false;
+  double since = f.t_start, shown = 0.0;
+  for (const Alarm& a : alarms) {
+    if (a.sensor != f.sensor) continue;
+    if (a.t >= f.t_end) break;
+    if (a.t > f.t_start) {
+      if (raised) shown += a.t - since;
+      since = a.t;
+    }
+    if (a.raised && !raised && a.t >= f.t_start) first_seen = true;
+    if (!a.raised && raised && first_seen) dropped = true;
+    raised = a.raised;
+  }
+  if (raised) shown += f.t_end - std::max(since, f.t_start);
+  fs->shown = shown / (f.t_end - f.t_start);
+  fs->held = fs->isolated && first_seen && raised && !dropped;
+}
+
 }  // namespace
 
 RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
@@ -147,6 +169,7 @@ RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& 
   }
   score_raises(alarms, windows, t_first, t_last, &out);
   for (std::size_t i = 0; i < n; ++i) {
+    score_shown(alarms, &out.faults[i]);
     if (!out.faults[i].detected) continue;
     score_recovery(alarms, i + 1 < n ? faults[i + 1].t_start : t_last, &out.faults[i]);
   }

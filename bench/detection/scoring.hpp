@@ -53,6 +53,11 @@ struct FaultScore {
   bool recovered = false;        ///< every condition cleared after the end (detected only)
   double recovery_delay = kNaN;  ///< [s]
   bool armed_at_onset = false;   ///< filled by the caller (the detector's arming time)
+  /// Raised on the faulty sensor from its first raise in the fault to the fault's end, never
+  /// cleared in between (a fault shown rectified while it lasts is, for the operator, gone).
+  bool held = false;
+  /// Share of the fault's duration during which its sensor was shown raised, in [0, 1].
+  double shown = 0.0;
 };
 
 struct RunScore {

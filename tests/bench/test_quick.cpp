@@ -155,6 +155,7 @@ TEST(BenchQuick, HarnessWorksAndTheOracleDetectsTheFaults) {
       EXPECT_LE(r.m[k][0], r.faults);
       EXPECT_LE(r.m[k][1], r.m[k][0]);
       EXPECT_LE(r.m[k][2], r.m[k][0]);
+      EXPECT_LE(r.m[k][3], r.m[k][1]);  // held: isolated, and raised until the end
       sums[k][0] += r.m[k][0];
       sums[k][1] += r.m[k][1];
     }

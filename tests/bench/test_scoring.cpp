@@ -32,6 +32,38 @@ TEST(BenchScoring, ARaiseInTheWindowDetectsWithItsDelayAndSensor) {
   EXPECT_NEAR(r.healthy_armed_time, 250 - 62, 1e-9);
 }
 
+TEST(BenchScoring, AFaultIsHeldWhenItsSensorStaysRaisedToItsEnd) {
+  // Raised at 100.4 and cleared after the end: held, shown for 59.6 of 60 s.
+  const RunScore held =
+      score_run({{kG, FaultKind::kBias, 100, 160}}, {raise(100.4, kG), clear(163, kG)}, 0, 300, 0);
+  EXPECT_TRUE(held.faults[0].held);
+  EXPECT_NEAR(held.faults[0].shown, 59.6 / 60.0, 1e-12);
+  // Cleared at 103 while the bias lasts, raised again when it ends (its removal is a step
+  // too): detected and isolated, but not held; shown for 3 s.
+  const RunScore early = score_run(
+      {{kA, FaultKind::kBias, 150, 180}},
+      {raise(150.3, kA), clear(153.3, kA), raise(180.3, kA), clear(183.3, kA)}, 0, 300, 0);
+  EXPECT_TRUE(early.faults[0].detected);
+  EXPECT_TRUE(early.faults[0].isolated);
+  EXPECT_FALSE(early.faults[0].held);
+  EXPECT_NEAR(early.faults[0].shown, 3.0 / 30.0, 1e-12);
+  // Cleared and raised again within the fault: not held, shown for both stretches.
+  const RunScore gap =
+      score_run({{kG, FaultKind::kDrift, 100, 160}},
+                {raise(110, kG), clear(120, kG), raise(130, kG), clear(161, kG)}, 0, 300, 0);
+  EXPECT_FALSE(gap.faults[0].held);
+  EXPECT_NEAR(gap.faults[0].shown, 40.0 / 60.0, 1e-12);
+  // The other sensor raised throughout: not held (not isolated), its sensor shown never.
+  const RunScore other =
+      score_run({{kG, FaultKind::kBias, 100, 160}}, {raise(100.2, kA), clear(161, kA)}, 0, 300, 0);
+  EXPECT_FALSE(other.faults[0].held);
+  EXPECT_EQ(other.faults[0].shown, 0.0);
+  // Never detected: neither.
+  const RunScore missed = score_run({{kG, FaultKind::kScale, 100, 160}}, {}, 0, 300, 0);
+  EXPECT_FALSE(missed.faults[0].held);
+  EXPECT_EQ(missed.faults[0].shown, 0.0);
+}
+
 TEST(BenchScoring, TheFirstRaiseDecidesTheIsolation) {
   const RunScore wrong =
       score_run({{kA, FaultKind::kStuck, 100, 160}}, {raise(101, kG), raise(102, kA)}, 0, 300, 0);
