@@ -90,19 +90,21 @@ class Hub {
   }
   /// Waits up to `timeout` for a board newer than *seen; true and the server-sent events that
   /// bring a page from board *seen to the newest: the deltas since, or the whole board when
-  /// the page has none yet or is further behind than the deltas kept.
+  /// the page has none yet, is further behind than the deltas kept or the deltas since would
+  /// be longer than it.
   bool next(std::uint64_t* seen, std::string* out, std::chrono::milliseconds timeout) {
     std::unique_lock<std::mutex> l(m_);
     cv_.wait_for(l, timeout, [&] { return stop_ || version_ > *seen; });
     if (stop_ || version_ <= *seen) return false;
     out->clear();
-    if (*seen == 0 || deltas_.empty() || deltas_.front().first > *seen + 1) {
-      *out = "data: " + board_ + "\n\n";
-    } else {
+    if (*seen > 0 && !deltas_.empty() && deltas_.front().first <= *seen + 1) {
       for (const auto& [version, delta] : deltas_) {
         if (version > *seen) *out += "data: " + delta + "\n\n";
       }
     }
+    // A page further behind than the deltas kept, or whose deltas would weigh more than the
+    // whole board, gets the whole board.
+    if (out->empty() || out->size() > board_.size()) *out = "data: " + board_ + "\n\n";
     *seen = version_;
     return true;
   }

@@ -294,6 +294,12 @@ test('a board of 100 emulated vessels loads and stays responsive', async () => {
       return bare(server) === bare(board) ? server.vessels.length : 0;
     }), 30);
   assert.equal(same, 100);
+  // While a pointer is down the board waits (a click is not lost under a redraw); a press the
+  // browser takes over (pointercancel: a touch that scrolls) lets it go on too.
+  await page.evaluate(() => document.dispatchEvent(new PointerEvent('pointerdown')));
+  await page.waitForFunction(() => stale === true, null, { timeout: 30000 });
+  await page.evaluate(() => document.dispatchEvent(new PointerEvent('pointercancel')));
+  await page.waitForFunction(() => stale === false && holding === false, null, { timeout: 5000 });
   // The audible signal (IEC 62923): off until the operator switches it on; then sounding while
   // an alert is active and unacknowledged (the tab's title counts them); Silence stops it.
   assert.equal(await page.getAttribute('body', 'data-sounding'), 'false', 'no sound before a click');

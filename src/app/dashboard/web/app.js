@@ -324,11 +324,15 @@ for (const id of ['f-vessel', 'f-sensor', 'f-state']) {
   document.getElementById(id).addEventListener('change', () => board && renderEvents());
 }
 document.addEventListener('pointerdown', () => { holding = true; });
-document.addEventListener('pointerup', () => {
-  holding = false;
-  // after the click event of this press has run
-  setTimeout(() => { if (stale && !holding) { stale = false; render(); } }, 0);
-});
+// A press ends with pointerup, or with pointercancel when the browser takes it over (a touch
+// that scrolls, a long press): either way the board is drawn again.
+for (const type of ['pointerup', 'pointercancel']) {
+  document.addEventListener(type, () => {
+    holding = false;
+    // after the click event of this press has run
+    setTimeout(() => { if (stale && !holding) { stale = false; render(); } }, 0);
+  });
+}
 document.getElementById('operator').value = localStorage.getItem('usv-fdi-operator') || '';
 fetch('/api/me').then((r) => (r.ok ? r.json() : null)).then((m) => {
   if (m) me = m;
