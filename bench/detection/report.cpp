@@ -98,7 +98,7 @@ void write_method_result(std::ostream& o, const Case& c, const MethodResult& m) 
   for (std::size_t j = 0; j < m.score.false_alarm_events.size(); ++j) {
     const Alarm& a = m.score.false_alarm_events[j];
     o << (j ? ", " : "") << "[" << json_num(a.t) << ", " << json_str(to_string(a.sensor)) << ", "
-      << json_str(to_string(a.kind)) << "]";
+      << json_str(to_string(a.kind)) << ", " << json_num(m.score.false_alarm_durations[j]) << "]";
   }
   o << "]";
   for (const FaultScore& f : m.score.faults) {

@@ -91,6 +91,14 @@ void score_raises(const std::vector<Alarm>& alarms, const DetectionWindows& wind
     if (w < 0) {
       out->false_alarm_times.push_back(a.t);
       out->false_alarm_events.push_back(a);
+      double until = t_last;
+      for (const Alarm& b : alarms) {
+        if (b.t > a.t && b.sensor == a.sensor && !b.raised) {
+          until = std::min(b.t, t_last);
+          break;
+        }
+      }
+      out->false_alarm_durations.push_back(until - a.t);
       continue;
     }
     FaultScore& fs = out->faults[static_cast<std::size_t>(w)];

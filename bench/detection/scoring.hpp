@@ -64,9 +64,11 @@ struct RunScore {
   std::vector<FaultScore> faults;
   std::vector<double> false_alarm_times;  ///< [s]
   std::vector<Alarm> false_alarm_events;  ///< the same raises, with their sensor and kind
-  double span = 0.0;                      ///< t_last - t_first [s]
-  double healthy_time = 0.0;              ///< span minus detection windows [s]
-  double healthy_armed_time = 0.0;        ///< the part of it after arming [s]
+  /// How long each false alarm stayed raised: to its sensor's next clear, or the run's end [s].
+  std::vector<double> false_alarm_durations;
+  double span = 0.0;                ///< t_last - t_first [s]
+  double healthy_time = 0.0;        ///< span minus detection windows [s]
+  double healthy_armed_time = 0.0;  ///< the part of it after arming [s]
   std::size_t false_alarms() const { return false_alarm_times.size(); }
 };
 

@@ -111,6 +111,13 @@ TEST(BenchScoring, RaisesOutsideEveryWindowAreFalseAlarmsAndClearsAreNot) {
 TEST(BenchScoring, AHealthyRunIsAllHealthyTimeAndRaisesOutsideItAreIgnored) {
   const RunScore r = score_run({}, {raise(-5, kG), raise(5, kG), raise(3601, kA)}, 0, 3600, kNaN);
   EXPECT_EQ(r.false_alarms(), 1u);
+  ASSERT_EQ(r.false_alarm_durations.size(), 1u);
+  EXPECT_NEAR(r.false_alarm_durations[0], 3595.0, 1e-9);  // never cleared: to the run's end
+  const RunScore d =
+      score_run({}, {raise(5, kG), raise(6, kA), clear(8, kA), clear(12.5, kG)}, 0, 3600, kNaN);
+  ASSERT_EQ(d.false_alarm_durations.size(), 2u);
+  EXPECT_NEAR(d.false_alarm_durations[0], 7.5, 1e-9);  // to its own sensor's clear
+  EXPECT_NEAR(d.false_alarm_durations[1], 2.0, 1e-9);
   EXPECT_NEAR(r.healthy_time, 3600, 1e-9);
   EXPECT_EQ(r.healthy_armed_time, 0.0);  // never armed
 }
