@@ -174,6 +174,20 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
       << seen.text << f.log("ros2") << f.log("svc");
   EXPECT_FALSE(seen.levels.count("usv_fdi: " + ms + " unknown")) << "no unknown-sensor fault\n"
                                                                  << seen.text;
+  // The publisher done, the sidecar has every sample and what it shows is final: an
+  // acknowledgement sent while the scenario still runs can meet a later event of it (an
+  // ASan run: the accelerometer's raise withdrawn as model mismatch at 65.8 s, acknowledged,
+  // then the fault's removal at 80 s raised anew and left unacknowledged).
+  ASSERT_TRUE(pub.process().wait_exit(seconds(90)).has_value()) << f.log("pub");
+  EXPECT_EQ(*pub.process().wait_exit(milliseconds(0)), 0) << f.log("pub");
+  read_until(diag.process(), &seen, seconds(3), [] { return false; });  // the last changes
+  ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
+                         [&] {
+                           return seen.level(accel) == 1 && seen.level(gyro) == 1 &&
+                                  seen.last[accel].values.at("state") == "cleared" &&
+                                  seen.last[gyro].values.at("state") == "cleared";
+                         }))
+      << seen.text << f.log("ros2") << f.log("svc");
 
   // WHEN an operator acknowledges both events (usv-fdi monitor --ack)
   const auto ack = f.run_to_end("ack",
@@ -188,10 +202,6 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
                          [&] { return seen.level(accel) == 0 && seen.level(gyro) == 0; }))
       << seen.text << f.log("ros2") << f.log("svc");
   EXPECT_EQ(seen.last[gyro].values.at("state"), "acknowledged");
-
-  // The publisher is done, the sidecar saw every sample in order.
-  ASSERT_TRUE(pub.process().wait_exit(seconds(60)).has_value()) << f.log("pub");
-  EXPECT_EQ(*pub.process().wait_exit(milliseconds(0)), 0) << f.log("pub");
 
   // The keyless mirror of the fault events carries the lifecycle too.
   EXPECT_GE(seen.mirrors.size(), 4u) << seen.text;
