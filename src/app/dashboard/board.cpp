@@ -208,18 +208,24 @@ json ack_list_json(const std::deque<AckOutcome>& acks) {
 
 std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
+/// What every board and every delta carries beside its vessels and events.
+json board_fields(const BoardInput& in, double now, const std::deque<AckOutcome>& acks) {
+  return json{{"now", num(now)},
+              {"silent_after", num(in.silent_after)},
+              {"conflicts", in.conflicts},
+              {"acks", ack_list_json(acks)}};
+}
+
 }  // namespace
 
 json board_json(const BoardInput& in, const EventHistory& events,
                 const std::deque<AckOutcome>& acks, double now) {
   json vessels = json::array();
   for (auto& [m, v] : vessel_entries(in, now)) vessels.push_back(std::move(v));
-  return json{{"now", num(now)},
-              {"silent_after", num(in.silent_after)},
-              {"conflicts", in.conflicts},
-              {"vessels", std::move(vessels)},
-              {"events", events.to_json(now)},
-              {"acks", ack_list_json(acks)}};
+  json board = board_fields(in, now, acks);
+  board["vessels"] = std::move(vessels);
+  board["events"] = events.to_json(now);
+  return board;
 }
 
 BoardFrame BoardFramer::frame(const BoardInput& in, const EventHistory& events,
@@ -248,25 +254,17 @@ BoardFrame BoardFramer::frame(const BoardInput& in, const EventHistory& events,
   const std::size_t fresh =
       static_cast<std::size_t>(std::min<std::uint64_t>(added - events_framed_, events.size()));
   events_framed_ = added;
-  const json acks_j = ack_list_json(acks);
-  json full{{"now", num(now)},
-            {"silent_after", num(in.silent_after)},
-            {"conflicts", in.conflicts},
-            {"vessels", std::move(vessels)},
-            {"events", events.to_json(now)},
-            {"acks", acks_j},
-            {"can_ack", can_ack}};
-  json delta{{"delta", true},
-             {"now", num(now)},
-             {"silent_after", num(in.silent_after)},
-             {"conflicts", in.conflicts},
-             {"vessels", std::move(changed)},
-             {"removed", std::move(removed)},
-             {"events", events.newest_json(fresh, now)},
-             {"event_capacity", events.capacity()},
-             {"heard_age", std::move(ages)},
-             {"acks", acks_j},
-             {"can_ack", can_ack}};
+  json full = board_fields(in, now, acks);
+  full["can_ack"] = can_ack;
+  json delta = full;
+  full["vessels"] = std::move(vessels);
+  full["events"] = events.to_json(now);
+  delta["delta"] = true;
+  delta["vessels"] = std::move(changed);
+  delta["removed"] = std::move(removed);
+  delta["events"] = events.newest_json(fresh, now);
+  delta["event_capacity"] = events.capacity();
+  delta["heard_age"] = std::move(ages);
   return BoardFrame{dump(full), dump(delta)};
 }
 
