@@ -91,13 +91,11 @@ void score_raises(const std::vector<Alarm>& alarms, const DetectionWindows& wind
     if (w < 0) {
       out->false_alarm_times.push_back(a.t);
       out->false_alarm_events.push_back(a);
-      double until = t_last;
-      for (const Alarm& b : alarms) {
-        if (b.t > a.t && b.sensor == a.sensor && !b.raised) {
-          until = std::min(b.t, t_last);
-          break;
-        }
-      }
+      // Alarms are in time order: its clear, if any, comes after it.
+      const auto clear = std::find_if(
+          alarms.begin() + (&a - alarms.data()) + 1, alarms.end(),
+          [&](const Alarm& b) { return b.t > a.t && b.sensor == a.sensor && !b.raised; });
+      const double until = clear == alarms.end() ? t_last : std::min(clear->t, t_last);
       out->false_alarm_durations.push_back(until - a.t);
       continue;
     }
