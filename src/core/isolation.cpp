@@ -300,6 +300,7 @@ void Isolator::apply_jump_verdict(int c, const JumpVerdict& v, const Vec2& e, do
     d.c_a = ec(0) / ec.norm();
     d.c_g = ec(1) / ec.norm();
   };
+  if (!(sens_[c].cond.sources & kJump)) chan_[c].jump_handed = false;
   if (v.step == JumpVerdict::Change::kRaise) chan_[c].jump_at = t;
   if (v.noise == JumpVerdict::Change::kRaise && sens_[c].cond.active &&
       sens_[c].cond.kind == FaultKind::kBias &&
@@ -326,6 +327,15 @@ void Isolator::apply_jump_verdict(int c, const JumpVerdict& v, const Vec2& e, do
     set_condition(sensor, kJump, false, FaultKind::kBias, t, std::string(name) + "jump withdrawn",
                   out);
   }
+  // The check holds an offset until it jumps back. A fault the observers hold and have named
+  // otherwise (a scale error, a drift, a frozen output) has no jump back to wait for: its
+  // own detectors decide when it ends.
+  if ((sens_[c].cond.sources & kJump) && chan_[c].jump_handed &&
+      sens_[c].cond.kind != FaultKind::kBias) {
+    set_condition(sensor, kJump, false, FaultKind::kBias, t,
+                  std::string(name) + "the fault is no offset", out);
+    jump_[c].release();
+  }
 }
 
 void Isolator::jump_was_noise(int c, const std::string& message, double t,
@@ -348,20 +358,26 @@ void Isolator::jump_was_noise(int c, const std::string& message, double t,
 
 void Isolator::hand_jump_to_observers(int c, const char* name, double t,
                                       std::vector<Detection>* out) {
-  // Once the observers are live they hold a jump like any residual fault (their cross
-  // residual sees whether the offset is still there, or has gone without a jump back).
+  // Once the observers are live they hold a jump like any residual fault, and the jump check
+  // goes on holding it too: the condition clears when both let go. The observers' residual
+  // alone let a bias in a seaway go within seconds while it was still there (the model's
+  // residual is only so sensitive); the jump check lets go at the jump back, or hold_max.
   const Sensor sensor = channel_sensor(c);
-  const bool held = sens_[c].cond.sources & kResidual;  // the observers hold it already
+  if (chan_[c].jump_handed) return;
+  if (sens_[c].cond.sources & kResidual) {
+    // The observers hold a fault on this channel already and decide when it ends (a jump
+    // now may be that fault's end, a drift's fall back to the truth).
+    set_condition(sensor, kJump, false, FaultKind::kBias, t, "", out);
+    jump_[c].release();
+    return;
+  }
+  chan_[c].jump_handed = true;
   set_condition(sensor, kResidual, true, FaultKind::kBias, t,
                 std::string(name) + "held by the observers", out);
-  set_condition(sensor, kJump, false, FaultKind::kBias, t, "", out);
-  if (!held) {
-    sens_[c].raised_at = t;
-    sens_[c].below_since = kNaN;
-    // Its kind is refined from the residuals' shape like any other (a scale error jumps).
-    if (sens_[c].cond.kind == FaultKind::kBias) chan_[c].refine_at = t + 0.5 * p_.classify_window;
-  }
-  jump_[c].release();
+  sens_[c].raised_at = t;
+  sens_[c].below_since = kNaN;
+  // Its kind is refined from the residuals' shape like any other (a scale error jumps).
+  if (sens_[c].cond.kind == FaultKind::kBias) chan_[c].refine_at = t + 0.5 * p_.classify_window;
 }
 
 void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection>* out) {

@@ -251,6 +251,7 @@ class Isolator {
     std::deque<std::pair<double, double>> hist_d;  ///< (t, raw cross residual)
     std::deque<std::pair<double, double>> hist_x;  ///< (t, other-observer state)
     double jump_at = kNaN;                         ///< time of the channel's last jump raise
+    bool jump_handed = false;  ///< the raised jump was handed to the observers (both hold it)
     // Holding a raised residual fault (see hold_or_clear).
     DedicatedObserver mon;    ///< monitor: the observer, not reconfigured
     bool mon_on = false;      ///< monitor running (channel raised)
