@@ -345,6 +345,8 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   if (!std::isfinite(y)) return v;
   if (raised_ && t - raised_at_ >= p_.hold_max) {
     raised_ = false;
+    let_go_offset_ = offset_;
+    let_go_at_ = t;
     v.step = JumpVerdict::Change::kClear;
     v.message = "no jump back within " + std::to_string(p_.hold_max) + " s";
   }
@@ -481,7 +483,12 @@ void JumpCheck::decide_step(double t, int m_best, double f_best, JumpVerdict* v)
   const double onset = ts_[static_cast<std::size_t>((z_.newest() - m_best + cap) % cap)];
   pending_n_ = 0;
   char buf[200];
-  if (!raised_) {
+  if (!raised_ && std::isfinite(let_go_at_) && t - let_go_at_ <= p_.history &&
+      f_best * let_go_offset_ < 0 && std::abs(f_best) >= 0.5 * std::abs(let_go_offset_)) {
+    // The end of the offset let go at hold_max: the channel is back where it was before it.
+    let_go_at_ = kNaN;
+  } else if (!raised_) {
+    let_go_at_ = kNaN;
     raised_ = true;
     offset_ = f_best;
     raised_at_ = t;

@@ -217,6 +217,27 @@ TEST(JumpCheck, NothingIsRaisedBeforeLearnTimeAndAnUnreturnedJumpIsHeldForHoldMa
   EXPECT_NEAR(s.step_t[1], s.step_t[0] + p.hold_max, 0.2);
 }
 
+TEST(JumpCheck, TheEndOfAnOffsetLetGoAtHoldMaxIsNoNewJump) {
+  // GIVEN a 10 sigma offset on [100, 170) s, longer than hold_max, and another one from 185 s
+  Channel c;
+  const auto rows = channel(c, 205.0, [](double t, long) {
+    return (t >= 100.0 && t < 170.0) || t >= 185.0 ? 10.0 * kSigma : 0.0;
+  });
+  JumpParams p;
+  ASSERT_LT(100.0 + p.hold_max, 169.0);
+  const Seen s = run_check(rows, p);
+  // THEN the first is raised and let go at hold_max; its end at 170 s (the channel back at
+  // the level before it) is not raised as a new jump; the next offset is
+  ASSERT_EQ(s.steps.size(), 3u);
+  EXPECT_EQ(s.steps[0].step, JumpVerdict::Change::kRaise);
+  EXPECT_NEAR(s.step_t[0], 100.0, 0.5);
+  EXPECT_EQ(s.steps[1].step, JumpVerdict::Change::kClear);
+  EXPECT_NEAR(s.step_t[1], s.step_t[0] + p.hold_max, 0.2);
+  EXPECT_EQ(s.steps[2].step, JumpVerdict::Change::kRaise);
+  EXPECT_GE(s.step_t[2], 185.0);
+  EXPECT_LE(s.step_t[2], 185.5);
+}
+
 TEST(JumpCheck, BadParametersNameTheKey) {
   JumpParams p;
   p.persist_time = 1.0;  // longer than post_window

@@ -24,7 +24,9 @@
 // against max(noise_threshold, margin x its healthy maximum).
 //
 // A raised jump holds until a jump back (of the opposite sign and at least half the offset
-// so far; a jump of the same sign, or a smaller one back, adds to the offset), or hold_max. Samples
+// so far; a jump of the same sign, or a smaller one back, adds to the offset), or hold_max; a
+// jump back to the level before an offset let go at hold_max (within `history`) is its end, not
+// a new jump. Samples
 // are taken as equally spaced at the learned interval: one or a few dropped samples are filled by
 // linear interpolation, a gap longer than max_gap restarts the windows.
 #pragma once
@@ -101,6 +103,7 @@ class JumpCheck {
   void release() {
     raised_ = false;
     offset_ = 0.0;
+    let_go_at_ = kNaN;
   }
 
   bool armed() const { return armed_; }
@@ -216,6 +219,10 @@ class JumpCheck {
   bool step_reported_ = false, noise_reported_ = false;  ///< their raise was reported
   double offset_ = 0.0;  ///< the offset since the raise (the jumps added up)
   double raised_at_ = kNaN;
+  /// The offset let go at hold_max without a jump back, and when: for `history` seconds a jump
+  /// back to the level before it is that offset's end, not a new jump.
+  double let_go_offset_ = 0.0;
+  double let_go_at_ = kNaN;
   bool noise_raised_ = false;
   double noise_raised_at_ = kNaN;
   double noise_below_since_ = kNaN;
