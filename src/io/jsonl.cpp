@@ -4,36 +4,10 @@
 #include <cstdio>
 #include <ostream>
 
+#include "usv_fdi/core/text.hpp"
+
 namespace usvfdi::io {
 namespace {
-
-/// Length of the valid UTF-8 sequence starting at s[i], or 0 when it is not valid.
-std::size_t utf8_length(const std::string& s, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-  const unsigned char c = b(i);
-  std::size_t n = 0;
-  unsigned cp = 0;
-  if (c >= 0xC2 && c <= 0xDF) {
-    n = 2;
-    cp = c & 0x1Fu;
-  } else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    cp = c & 0x0Fu;
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    cp = c & 0x07u;
-  } else {
-    return 0;
-  }
-  if (i + n > s.size()) return 0;
-  for (std::size_t k = 1; k < n; ++k) {
-    if ((b(i + k) & 0xC0u) != 0x80u) return 0;
-    cp = (cp << 6) | (b(i + k) & 0x3Fu);
-  }
-  if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF))) return 0;
-  if (cp >= 0xD800 && cp <= 0xDFFF) return 0;  // surrogates are not characters
-  return n;
-}
 
 std::string array4(const Vec4& a) {
   return "[" + json_number(a(0)) + "," + json_number(a(1)) + "," + json_number(a(2)) + "," +
@@ -85,7 +59,8 @@ std::string json_string(const std::string& s) {
       ++i;
       continue;
     }
-    const std::size_t n = utf8_length(s, i);
+    unsigned cp = 0;
+    const std::size_t n = utf8_sequence(s, i, &cp);
     if (n == 0) {
       o += "\\ufffd";
       ++i;

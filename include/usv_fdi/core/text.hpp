@@ -11,6 +11,40 @@
 
 namespace usvfdi {
 
+/// The length of the valid UTF-8 sequence at s[i] (1 for ASCII), its code point in *cp; 0 when
+/// it is not valid UTF-8: a stray continuation byte, a sequence cut short, an overlong form, a
+/// surrogate, or a value past U+10FFFF.
+inline std::size_t utf8_sequence(std::string_view s, std::size_t i, unsigned* cp) {
+  const unsigned char c = static_cast<unsigned char>(s[i]);
+  std::size_t n = 0;
+  unsigned v = 0;
+  if (c < 0x80) {
+    n = 1;
+    v = c;
+  } else if (c >= 0xc2 && c <= 0xdf) {
+    n = 2;
+    v = c & 0x1fu;
+  } else if (c >= 0xe0 && c <= 0xef) {
+    n = 3;
+    v = c & 0x0fu;
+  } else if (c >= 0xf0 && c <= 0xf4) {
+    n = 4;
+    v = c & 0x07u;
+  } else {
+    return 0;
+  }
+  if (i + n > s.size()) return 0;
+  for (std::size_t k = 1; k < n; ++k) {
+    const unsigned char cc = static_cast<unsigned char>(s[i + k]);
+    if ((cc & 0xc0u) != 0x80u) return 0;
+    v = (v << 6) | (cc & 0x3fu);
+  }
+  if ((n == 3 && v < 0x800) || (n == 4 && (v < 0x10000 || v > 0x10ffff))) return 0;
+  if (v >= 0xd800 && v <= 0xdfff) return 0;  // surrogates are not characters
+  *cp = v;
+  return n;
+}
+
 /// `s` with every byte that is not printable text replaced by a visible escape: newline -> "\n",
 /// CR -> "\r", tab -> "\t", any other C0 control or DEL -> "\xHH"; in
 /// UTF-8, the C1 controls (U+0080..U+009F) and the bidirectional overrides and isolates
@@ -50,31 +84,9 @@ inline std::string escape_text(std::string_view s) {
       ++i;
       continue;
     }
-    // A UTF-8 sequence: its length from the lead byte, then continuation bytes, no overlong
-    // form, no surrogate, at most U+10FFFF.
-    std::size_t n = 0;
     unsigned cp = 0;
-    if (c >= 0xc2 && c <= 0xdf) {
-      n = 2;
-      cp = c & 0x1fu;
-    } else if (c >= 0xe0 && c <= 0xef) {
-      n = 3;
-      cp = c & 0x0fu;
-    } else if (c >= 0xf0 && c <= 0xf4) {
-      n = 4;
-      cp = c & 0x07u;
-    }
-    bool ok = n > 0 && i + n <= s.size();
-    for (std::size_t k = 1; ok && k < n; ++k) {
-      const unsigned char cc = static_cast<unsigned char>(s[i + k]);
-      ok = (cc & 0xc0u) == 0x80u;
-      cp = (cp << 6) | (cc & 0x3fu);
-    }
-    if (ok) {
-      ok = !(n == 3 && cp < 0x800) && !(n == 4 && (cp < 0x10000 || cp > 0x10ffff)) &&
-           !(cp >= 0xd800 && cp <= 0xdfff);
-    }
-    if (!ok) {
+    const std::size_t n = utf8_sequence(s, i, &cp);
+    if (n == 0) {
       hex(c, "\\x%02x");
       ++i;
       continue;

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "usv_fdi/core/text.hpp"
+
 namespace usvfdi::app::dashboard {
 namespace {
 
@@ -115,35 +117,11 @@ std::vector<unsigned char> derive(const std::string& password,
 /// The code point of the UTF-8 sequence at s[*i] (advancing *i), -1 if it is not valid UTF-8
 /// (overlong forms, surrogates and values past U+10FFFF included).
 long next_code_point(const std::string& s, std::size_t* i) {
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-  const unsigned char c = byte(*i);
-  int extra = 0;
-  long cp = 0;
-  if (c < 0x80) {
-    ++*i;
-    return c;
-  } else if ((c & 0xE0) == 0xC0) {
-    extra = 1;
-    cp = c & 0x1F;
-  } else if ((c & 0xF0) == 0xE0) {
-    extra = 2;
-    cp = c & 0x0F;
-  } else if ((c & 0xF8) == 0xF0) {
-    extra = 3;
-    cp = c & 0x07;
-  } else {
-    return -1;
-  }
-  if (*i + static_cast<std::size_t>(extra) >= s.size()) return -1;  // cut short
-  for (int k = 1; k <= extra; ++k) {
-    const unsigned char b = byte(*i + static_cast<std::size_t>(k));
-    if ((b & 0xC0) != 0x80) return -1;
-    cp = (cp << 6) | (b & 0x3F);
-  }
-  static const long kMin[] = {0, 0x80, 0x800, 0x10000};
-  if (cp < kMin[extra] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return -1;
-  *i += static_cast<std::size_t>(extra) + 1;
-  return cp;
+  unsigned cp = 0;
+  const std::size_t n = utf8_sequence(s, *i, &cp);
+  if (n == 0) return -1;
+  *i += n;
+  return static_cast<long>(cp);
 }
 
 /// Characters that change how the rest of a line reads or do not show: C1 controls, soft hyphen,
