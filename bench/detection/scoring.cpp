@@ -85,7 +85,8 @@ void set_healthy_time(const std::vector<InjectedFault>& faults, const DetectionW
 /// one outside every window is a false alarm.
 void score_raises(const std::vector<Alarm>& alarms, const DetectionWindows& windows, double t_first,
                   double t_last, RunScore* out) {
-  for (const Alarm& a : alarms) {
+  for (std::size_t k = 0; k < alarms.size(); ++k) {
+    const Alarm& a = alarms[k];
     if (!a.raised || a.t < t_first || a.t > t_last) continue;
     const int w = windows.of(a.t);
     if (w < 0) {
@@ -93,7 +94,7 @@ void score_raises(const std::vector<Alarm>& alarms, const DetectionWindows& wind
       out->false_alarm_events.push_back(a);
       // Alarms are in time order: its clear, if any, comes after it.
       const auto clear = std::find_if(
-          alarms.begin() + (&a - alarms.data()) + 1, alarms.end(),
+          alarms.begin() + static_cast<std::ptrdiff_t>(k) + 1, alarms.end(),
           [&](const Alarm& b) { return b.t > a.t && b.sensor == a.sensor && !b.raised; });
       const double until = clear == alarms.end() ? t_last : std::min(clear->t, t_last);
       out->false_alarm_durations.push_back(until - a.t);
