@@ -6,7 +6,8 @@
 //   * the yaw rate from sensor_msgs/Imu (angular_velocity.z),
 //   * the sway velocity from geometry_msgs/TwistStamped (twist.linear.y) or nav_msgs/Odometry
 //     (twist.twist.linear.y),
-//   * the rudder angle from std_msgs/Float64 [rad],
+//   * the rudder angle from std_msgs/Float64 [rad] (no header: paired with the Imu samples
+//     on the DDS source timestamps, the writers' clocks),
 // turns REP 103 signs into the project's (ros2_adapter.hpp), assembles INS samples on the Imu
 // stamps and republishes them as fdi::RudderSample + fdi::InsSample (MMSI --mmsi, seq 1, 2, 3,
 // ...) for the sidecar. It reads the vessel's FaultEvents and FdiStatus as the monitor does
@@ -66,7 +67,6 @@ struct Ros2Args {
   std::string rudder_topic = "/rudder_angle";
   int rudder_sign = 0;  ///< δ = rudder_sign * Float64.data; required
   ros2::AssemblyParams assembly;
-  double rudder_max_age = 1.0;  ///< wall time [s]
   double silent_after = 5.0;
   double diagnostics_period = 1.0;
   bool no_mirrors = false;
@@ -78,6 +78,7 @@ struct Ros2Args {
 struct Input {
   enum Kind { kYaw, kSway, kRudder, kSurge } kind = kYaw;
   double stamp = 0.0;  ///< header stamp [s] (none for the rudder)
+  double sent = 0.0;   ///< DDS source timestamp: when the writer wrote it (its clock) [s]
   double value = 0.0;
   bool valid = false;
 };
@@ -112,14 +113,15 @@ class InputQueue : public fdds::DataReaderListener {
         const double z = m.angular_velocity().z();
         // sensor_msgs/Imu: covariance element 0 = -1 means "no estimate of this field".
         const bool ok = std::isfinite(z) && m.angular_velocity_covariance()[0] != -1.0;
-        push({Input::kYaw, stamp_of(m.header()), ros2::yaw_rate_from_rep103(z), ok});
+        push({Input::kYaw, stamp_of(m.header()), sent_of(info), ros2::yaw_rate_from_rep103(z), ok});
       }
     } else if (reader == sway && odometry_) {
       nav_msgs::msg::Odometry m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
         const double y = m.twist().twist().linear().y();
-        push({Input::kSway, stamp_of(m.header()), ros2::sway_from_rep103(y), std::isfinite(y)});
+        push({Input::kSway, stamp_of(m.header()), sent_of(info), ros2::sway_from_rep103(y),
+              std::isfinite(y)});
         push_surge(m.header(), m.twist().twist().linear().x());
       }
     } else if (reader == sway) {
@@ -127,7 +129,8 @@ class InputQueue : public fdds::DataReaderListener {
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
         const double y = m.twist().linear().y();
-        push({Input::kSway, stamp_of(m.header()), ros2::sway_from_rep103(y), std::isfinite(y)});
+        push({Input::kSway, stamp_of(m.header()), sent_of(info), ros2::sway_from_rep103(y),
+              std::isfinite(y)});
         push_surge(m.header(), m.twist().linear().x());
       }
     } else if (reader == rudder) {
@@ -135,7 +138,7 @@ class InputQueue : public fdds::DataReaderListener {
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
         const double d = m.data();
-        push({Input::kRudder, std::nan(""), rudder_sign_ * d, std::isfinite(d)});
+        push({Input::kRudder, std::nan(""), sent_of(info), rudder_sign_ * d, std::isfinite(d)});
       }
     }
   }
@@ -156,6 +159,9 @@ class InputQueue : public fdds::DataReaderListener {
   static double stamp_of(const std_msgs::msg::Header& h) {
     return ros2::stamp_seconds(h.stamp().sec(), h.stamp().nanosec());
   }
+  static double sent_of(const fdds::SampleInfo& info) {
+    return ros2::stamp_seconds(info.source_timestamp.seconds(), info.source_timestamp.nanosec());
+  }
   void push(const Input& in) {
     {
       std::lock_guard<std::mutex> lock(m_);
@@ -169,7 +175,7 @@ class InputQueue : public fdds::DataReaderListener {
   }
   /// REP 103: x forward, so linear.x is the surge speed with the project's sign.
   void push_surge(const std_msgs::msg::Header& h, double x) {
-    if (surge_) push({Input::kSurge, stamp_of(h), x, std::isfinite(x)});
+    if (surge_) push({Input::kSurge, stamp_of(h), 0.0, x, std::isfinite(x)});
   }
 
   static constexpr std::size_t kCapacity = 8192;
@@ -372,10 +378,11 @@ class Adapter {
     return fmt::format(
         "{} INS, {} rudder and {} speed samples published; {} Imu, {} sway, {} rudder messages "
         "read ({} dropped from the full input queue); {} INS samples with a stale sway "
-        "velocity, {} sway samples refused (stamp repeated, backward or not finite); {} "
-        "DiagnosticArray messages",
+        "velocity, {} without a rudder angle, {} sway samples refused (stamp repeated, backward "
+        "or not finite); {} DiagnosticArray messages",
         ins_seq_, rudder_seq_, speed_seq_, yaw_in_, sway_in_, rudder_in_, inputs_.dropped(),
-        assembler_.sway_stale(), assembler_.sway_rejected(), diag_sent_);
+        assembler_.sway_stale(), assembler_.without_rudder(), assembler_.sway_rejected(),
+        diag_sent_);
   }
 
  private:
@@ -383,10 +390,7 @@ class Adapter {
     switch (i.kind) {
       case Input::kRudder:
         ++rudder_in_;
-        delta_ = i.value;
-        delta_valid_ = i.valid;
-        delta_at_ = now;
-        have_delta_ = true;
+        assembler_.add_rudder(i.sent, i.value, i.valid);
         break;
       case Input::kSway:
         ++sway_in_;
@@ -399,13 +403,12 @@ class Adapter {
         ++yaw_in_;
         ros2::YawSample y;
         y.stamp = i.stamp;
+        y.sent = i.sent;
         y.r = i.valid ? i.value : 0.0;
         y.r_valid = i.valid;
-        // Float64 has no stamp: the rudder angle in force when this Imu sample arrived (the
-        // latest received), stamped with the Imu stamp; none once it is --rudder-max-age old.
-        y.rudder = have_delta_ && now - delta_at_ <= a_.rudder_max_age;
-        y.delta = delta_;
-        y.delta_valid = delta_valid_;
+        // The rudder angle (Float64: no header) is the one written last before this Imu
+        // sample (source timestamps), sent stamped with the Imu stamp; none once it is
+        // --rudder-max-age older (ros2_adapter.hpp, InsAssembler).
         assembler_.add_yaw(y, now);
         break;
       }
@@ -535,8 +538,6 @@ class Adapter {
   fdds::DataWriter* rudder_ = nullptr;
   fdds::DataWriter* speed_ = nullptr;  ///< --surge-from-sway only
   std::uint64_t speed_seq_ = 0;
-  double delta_ = 0.0, delta_at_ = 0.0;
-  bool delta_valid_ = false, have_delta_ = false;
   std::uint64_t ins_seq_ = 0, rudder_seq_ = 0, yaw_in_ = 0, sway_in_ = 0, rudder_in_ = 0;
   std::uint64_t write_failures_ = 0, diag_sent_ = 0;
   std::vector<ros2::DiagStatus> last_diag_;
@@ -631,11 +632,13 @@ void register_ros2_command(CommandRegistry& registry) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   sub->add_option("--pair-wait", args.assembly.pair_wait,
-                  "wait this long (wall time) for the sway sample of an Imu stamp [s]")
+                  "wait this long (wall time) for the sway sample and the rudder angle of an "
+                  "Imu sample [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  sub->add_option("--rudder-max-age", args.rudder_max_age,
-                  "no rudder sample once the last Float64 was received this long ago [s]")
+  sub->add_option("--rudder-max-age", args.assembly.rudder_max_age,
+                  "an Imu sample goes without a rudder angle when the last Float64 was written "
+                  "this long before it (DDS source timestamps) [s]")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   sub->add_option("--silent-after", args.silent_after,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <iterator>
 
 namespace usvfdi::app::ros2 {
 
@@ -52,6 +53,22 @@ void InsAssembler::add_sway(double stamp, double v) {
   while (sway_.size() > 4096) sway_.pop_front();
 }
 
+void InsAssembler::add_rudder(double sent, double delta, bool valid) {
+  if (!std::isfinite(sent)) return;
+  const Rudder r{sent, valid ? delta : 0.0, valid && std::isfinite(delta)};
+  // One writer's source timestamps increase; a second writer's may interleave with them.
+  const auto at = std::upper_bound(rudder_.begin(), rudder_.end(), sent,
+                                   [](double t, const Rudder& x) { return t < x.sent; });
+  rudder_.insert(at, r);
+  // Keep what a pending INS sample can still use: the last angle written before
+  // rudder_max_age ahead of the oldest one, and everything after it.
+  const double newest = rudder_.back().sent;
+  const double keep_from =
+      (pending_.empty() ? newest : std::min(newest, pending_.front().s.sent)) - p_.rudder_max_age;
+  while (rudder_.size() > 2 && rudder_[1].sent < keep_from) rudder_.pop_front();
+  while (rudder_.size() > 4096) rudder_.pop_front();
+}
+
 void InsAssembler::add_yaw(const YawSample& s, double wall_now) {
   pending_.push_back({s, wall_now});
 }
@@ -60,11 +77,12 @@ std::vector<AssembledSample> InsAssembler::release(double wall_now) {
   std::vector<AssembledSample> out;
   while (!pending_.empty()) {
     const Pending& p = pending_.front();
-    const bool sway_caught_up = !sway_.empty() && sway_.back().first >= p.s.stamp - p_.same_stamp;
+    const bool caught_up = !sway_.empty() && sway_.back().first >= p.s.stamp - p_.same_stamp &&
+                           !rudder_.empty() && rudder_.back().sent >= p.s.sent;
     const bool waited = wall_now - p.arrived >= p_.pair_wait;
     const bool full = pending_.size() > p_.max_pending;
-    if (!sway_caught_up && !waited && !full) break;
-    if (full && !sway_caught_up && !waited) ++overflowed_;
+    if (!caught_up && !waited && !full) break;
+    if (full && !caught_up && !waited) ++overflowed_;
     out.push_back(assemble(p.s));
     pending_.pop_front();
   }
@@ -76,9 +94,7 @@ AssembledSample InsAssembler::assemble(const YawSample& s) {
   a.stamp = s.stamp;
   a.r = s.r;
   a.r_valid = s.r_valid;
-  a.rudder = s.rudder;
-  a.delta = s.delta;
-  a.delta_valid = s.delta_valid;
+  pair_rudder(s, &a);
   // The last sway sample at or before the stamp (within same_stamp), and the one after it.
   const std::pair<double, double>* before = nullptr;
   const std::pair<double, double>* after = nullptr;
@@ -104,6 +120,20 @@ AssembledSample InsAssembler::assemble(const YawSample& s) {
   }
   if (!a.v_valid) ++sway_stale_;
   return a;
+}
+
+void InsAssembler::pair_rudder(const YawSample& s, AssembledSample* a) {
+  // The last angle written at or before the Imu sample (the same instant counts: a writer
+  // that publishes the rudder first, as an autopilot's loop does, pairs exactly).
+  const auto after = std::upper_bound(rudder_.begin(), rudder_.end(), s.sent,
+                                      [](double t, const Rudder& x) { return t < x.sent; });
+  if (after == rudder_.begin() || !(s.sent - std::prev(after)->sent <= p_.rudder_max_age)) {
+    ++without_rudder_;
+    return;
+  }
+  a->rudder = true;
+  a->delta = std::prev(after)->delta;
+  a->delta_valid = std::prev(after)->valid;
 }
 
 const char* to_string(DiagLevel l) {

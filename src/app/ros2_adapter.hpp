@@ -7,7 +7,8 @@
 // y STARBOARD, z DOWN (v and r positive to starboard). Hence
 //   v = -twist.linear.y,   r = -angular_velocity.z.
 // The rudder angle (std_msgs/Float64, radians) has no ROS convention: δ = rudder_sign * data,
-// the sign given by the user (--rudder-sign).
+// the sign given by the user (--rudder-sign). It has no header either: it is paired with the
+// Imu samples on the DDS source timestamps (the writers' clocks).
 #pragma once
 
 #include <cstddef>
@@ -60,16 +61,19 @@ struct AssemblyParams {
   double pair_wait = 0.2;
   /// Pending INS samples at most (more: the oldest is assembled at once)
   std::size_t max_pending = 512;
+  /// A rudder angle written up to this much before an Imu sample (writers' clocks) goes with
+  /// it; older: the INS sample goes without one [s]
+  double rudder_max_age = 1.0;
 };
 
-/// One yaw-rate sample (from sensor_msgs/Imu) with the rudder angle in force when it arrived.
+/// One yaw-rate sample (from sensor_msgs/Imu).
 struct YawSample {
   double stamp = 0.0;  ///< header.stamp [s]
-  double r = 0.0;      ///< usv-fdi sign [rad/s]
+  /// When its writer wrote it: the DDS source timestamp, on the writer's clock [s]. The
+  /// rudder angle (std_msgs/Float64, no header) is paired on this clock.
+  double sent = 0.0;
+  double r = 0.0;  ///< usv-fdi sign [rad/s]
   bool r_valid = false;
-  bool rudder = false;  ///< a rudder sample goes with it (false: none received, or too old)
-  double delta = 0.0;   ///< usv-fdi sign [rad]
-  bool delta_valid = false;
 };
 
 /// An INS sample (and the rudder angle to go with it) ready for the sidecar.
@@ -83,37 +87,53 @@ struct AssembledSample {
 };
 
 /// Assembles INS samples on the yaw-rate (Imu) stamps. Each waits until a sway sample at or
-/// after its stamp has arrived, or for params.pair_wait of wall time; then its v is
+/// after its stamp and a rudder angle written at or after it have arrived, or for
+/// params.pair_wait of wall time; then its v is
 ///  * the sway sample at the same stamp (within same_stamp), else
 ///  * linear interpolation between the sway samples around its stamp when they are at most
 ///    sway_max_age apart, else
 ///  * the latest sway sample before its stamp when it is at most sway_max_age old, else
-///    invalid (no sway, or stale).
+///    invalid (no sway, or stale);
+/// and its rudder angle the one written last before it (source timestamps, at most
+/// rudder_max_age earlier), else none. The order of arrival does not matter: the readers of
+/// different topics deliver on different threads (Fast DDS data sharing for the bounded
+/// Float64), so a burst of one topic may arrive before or after the other's.
 /// Samples leave in the order their Imu samples arrived.
 class InsAssembler {
  public:
   explicit InsAssembler(const AssemblyParams& p) : p_(p) {}
 
   void add_sway(double stamp, double v);
+  /// A rudder angle written at `sent` (source timestamp [s]); `valid` false: the writer sent
+  /// a value that is not a number.
+  void add_rudder(double sent, double delta, bool valid);
   void add_yaw(const YawSample& s, double wall_now);
   /// The samples ready at wall time `wall_now`, in order.
   std::vector<AssembledSample> release(double wall_now);
 
-  std::uint64_t sway_stale() const { return sway_stale_; }        ///< assembled with v invalid
-  std::uint64_t overflowed() const { return overflowed_; }        ///< released early: queue full
-  std::uint64_t sway_rejected() const { return sway_rejected_; }  ///< non-finite or old
+  std::uint64_t sway_stale() const { return sway_stale_; }          ///< assembled with v invalid
+  std::uint64_t overflowed() const { return overflowed_; }          ///< released early: queue full
+  std::uint64_t sway_rejected() const { return sway_rejected_; }    ///< non-finite or old
+  std::uint64_t without_rudder() const { return without_rudder_; }  ///< none, or too old
 
  private:
   struct Pending {
     YawSample s;
     double arrived = 0.0;  ///< wall time
   };
+  struct Rudder {
+    double sent = 0.0;  ///< source timestamp [s]
+    double delta = 0.0;
+    bool valid = false;
+  };
   AssembledSample assemble(const YawSample& s);
+  void pair_rudder(const YawSample& s, AssembledSample* a);
 
   AssemblyParams p_;
   std::deque<std::pair<double, double>> sway_;  ///< (stamp, v), stamps increasing
+  std::deque<Rudder> rudder_;                   ///< source timestamps increasing
   std::deque<Pending> pending_;
-  std::uint64_t sway_stale_ = 0, overflowed_ = 0, sway_rejected_ = 0;
+  std::uint64_t sway_stale_ = 0, overflowed_ = 0, sway_rejected_ = 0, without_rudder_ = 0;
 };
 
 /// diagnostic_msgs/DiagnosticStatus levels.

@@ -42,6 +42,11 @@
 //     from 1000000 up, an unknown sensor 7, sequence 0), until SIGTERM/SIGINT or the timeout.
 //     Prints "flooding" once matched, then "flooded acks=N" and exits 0.
 //
+//   usv_fdi_dds_probe read-inputs --profiles FILE [DDS options] --mmsi M [--timeout SECONDS]
+//     A RELIABLE reader of the rudder samples a sidecar would read (usv_fdi/rudder). Prints
+//     "reading" once created, then "rudder stamp=.. delta=.. valid=.." per sample of vessel M,
+//     until SIGTERM/SIGINT (exit 0) or the timeout (exit 0).
+//
 //   usv_fdi_dds_probe writer-qos --profiles FILE --writer-profile NAME
 //     Joins the domain as the service does (FASTRTPS_DEFAULT_PROFILES_FILE first, then FILE)
 //     and prints the data writer profile's QoS as
@@ -118,7 +123,8 @@ Options parse(int argc, char** argv) {
   Options o;
   o.mode = argv[1];
   if (o.mode != "publish-faults" && o.mode != "read-faults" && o.mode != "writer-qos" &&
-      o.mode != "publish-inputs" && o.mode != "slow-reader" && o.mode != "flood-acks") {
+      o.mode != "publish-inputs" && o.mode != "slow-reader" && o.mode != "flood-acks" &&
+      o.mode != "read-inputs") {
     throw UsageError("unknown mode '" + o.mode + "'");
   }
   for (int i = 2; i < argc; ++i) {
@@ -475,6 +481,35 @@ int flood_acks(const Options& o) {
   return 0;
 }
 
+int read_inputs(const Options& o) {
+  if (o.mmsi == 0) throw UsageError("--mmsi is required");
+  install_signal_handlers();
+  const auto deadline = deadline_after(o.timeout_s);
+  DdsContext ctx(o.dds);
+  fdds::DataReader& reader = ctx.create_reader<fdi::RudderSample>(profiles::kRudderReaderReliable);
+  fdds::StatusCondition& condition = reader.get_statuscondition();
+  condition.set_enabled_statuses(fdds::StatusMask::data_available());
+  fdds::WaitSet waitset;
+  waitset.attach_condition(condition);
+  std::printf("reading\n");
+  std::fflush(stdout);
+  std::vector<fdi::RudderSample> batch;
+  while (!g_stop.load() && Clock::now() < deadline) {
+    fdds::ConditionSeq active;
+    (void)waitset.wait(active, eprosima::fastrtps::Duration_t(0, 100000000));
+    batch.clear();
+    usvfdi::dds::take_all(reader, batch);
+    for (const auto& r : batch) {
+      if (r.mmsi() != o.mmsi) continue;
+      std::printf("rudder stamp=%.9f delta=%.17g valid=%d\n", r.stamp(), r.delta(),
+                  r.valid() ? 1 : 0);
+    }
+    std::fflush(stdout);
+  }
+  (void)waitset.detach_condition(condition);
+  return 0;
+}
+
 int writer_qos(const Options& o) {
   if (o.writer_profile.empty()) throw UsageError("--writer-profile is required");
   DdsContext ctx(o.dds);  // loads the profiles exactly as the service does
@@ -509,6 +544,7 @@ int main(int argc, char** argv) {
     if (o.mode == "publish-inputs") return publish_inputs(o);
     if (o.mode == "slow-reader") return slow_reader(o);
     if (o.mode == "flood-acks") return flood_acks(o);
+    if (o.mode == "read-inputs") return read_inputs(o);
     return o.mode == "publish-faults" ? publish_faults(o) : read_faults(o);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "usv_fdi_dds_probe: %s\n", e.what());

@@ -6,7 +6,7 @@
 //   usv_fdi_ros2_probe publish-paper --profiles FILE --domain N --participant-profile P
 //       [--speed S] [--rudder-sign K] [--imu /imu/data] [--twist /velocity]
 //       [--rudder /rudder_angle] [--odometry /odom] [--qos default|sensor_data]
-//       [--timeout SECONDS] [--lead-in SECONDS]
+//       [--timeout SECONDS] [--lead-in SECONDS] [--burst N]
 //     The paper's scenario (Otter, 50 Hz, noise-free; gyro bias on [20, 40) s, accelerometer
 //     bias on [60, 80) s; --lead-in L: L s of healthy voyage before it, the faults L s later,
 //     so that samples lost before the first fault leave the engine time to arm) from the
@@ -15,8 +15,12 @@
 //     sensor_msgs/Imu (angular_velocity.z = -r), then geometry_msgs/TwistStamped
 //     (twist.linear.y = -v), stamps t; with --odometry, nav_msgs/Odometry on that topic
 //     (twist.twist.linear.y = -v) instead of the TwistStamped. --qos sensor_data: writers as
-//     rclcpp's sensor_data profile (BEST_EFFORT, KEEP_LAST 5). Waits (up to the timeout, default 20
-//     s) until a reader matches each writer, prints "publishing", then "published N" and exits 0.
+//     rclcpp's sensor_data profile (BEST_EFFORT, KEEP_LAST 5). --burst N: the samples go out N at
+//     a time, as a reader sees them when its delivery thread falls behind: the Imu and twist
+//     samples of N instants first, then their N rudder angles, each with the DDS source
+//     timestamp of the instant it stands for (a rudder angle just before its Imu sample).
+//     Waits (up to the timeout, default 20 s) until a reader matches each writer, prints
+//     "publishing", then "published N" and exits 0.
 //
 //   usv_fdi_ros2_probe read-diagnostics --profiles FILE --domain N --participant-profile P
 //     Reads /diagnostics (diagnostic_msgs/DiagnosticArray) and the transient-local mirror
@@ -79,6 +83,7 @@ struct Options {
   std::string imu = "rt/imu/data", twist = "rt/velocity", rudder = "rt/rudder_angle";
   std::string odometry;  ///< empty: TwistStamped on `twist`
   bool sensor_data = false;
+  unsigned burst = 1;
 };
 
 std::string rt(const std::string& ros) { return "rt/" + (ros[0] == '/' ? ros.substr(1) : ros); }
@@ -114,6 +119,9 @@ Options parse(int argc, char** argv) {
       o.rudder = rt(value);
     } else if (flag == "--odometry") {
       o.odometry = rt(value);
+    } else if (flag == "--burst") {
+      o.burst = static_cast<unsigned>(probe::parse_unsigned(flag, value));
+      if (o.burst < 1) throw UsageError("--burst: " + value + " (>= 1)");
     } else if (flag == "--qos") {
       if (value != "default" && value != "sensor_data") throw UsageError("--qos: " + value);
       o.sensor_data = value == "sensor_data";
@@ -232,43 +240,81 @@ int publish_paper(const Options& o) {
   usvfdi::SimRow row;
   auto t0 = probe::Clock::now();
   std::uint64_t n_pub = 0;
+  // One instant's messages, and its DDS source timestamp (system clock) with --burst.
+  struct Instant {
+    std_msgs::msg::Float64 rudder;
+    sensor_msgs::msg::Imu imu;
+    geometry_msgs::msg::TwistStamped twist;
+    nav_msgs::msg::Odometry odom;
+    double sent = 0.0;
+  };
+  std::vector<Instant> burst;
+  const auto write_at = [](fdds::DataWriter* w, void* data, double sent) {
+    if (sent > 0.0) {
+      w->write_w_timestamp(data, fdds::HANDLE_NIL, eprosima::fastrtps::Time_t(sent));
+    } else {
+      w->write(data);
+    }
+  };
+  const auto write_sway = [&](Instant& x, double sent) {
+    if (o.odometry.empty()) {
+      write_at(twist_w, &x.twist, sent);
+    } else {
+      write_at(twist_w, &x.odom, sent);
+    }
+  };
   while (!probe::g_stop.load() && sim.next(&row)) {
     const auto due = t0 + std::chrono::duration_cast<probe::Clock::duration>(
                               std::chrono::duration<double>(row.t / o.speed));
+    Instant x;
+    x.rudder.data(o.rudder_sign * row.delta);
+    set_stamp(&x.imu.header(), row.t);
+    x.imu.header().frame_id("imu_link");
+    x.imu.orientation().w(1.0);
+    x.imu.orientation_covariance()[0] = -1.0;  // no orientation estimate
+    x.imu.angular_velocity().z(-row.r);        // REP 103: z up
+    set_stamp(&x.twist.header(), row.t);
+    x.twist.header().frame_id("base_link");
+    x.twist.twist().linear().x(1.0);
+    x.twist.twist().linear().y(-row.v);  // REP 103: y to port
+    x.twist.twist().angular().z(-row.r);
+    if (!o.odometry.empty()) {
+      x.odom.header(x.twist.header());
+      x.odom.header().frame_id("odom");
+      x.odom.child_frame_id("base_link");
+      x.odom.pose().pose().orientation().w(1.0);
+      x.odom.twist().twist(x.twist.twist());
+    }
+    burst.push_back(x);
+    ++n_pub;
+    if (burst.size() < o.burst) continue;
     const auto now = probe::Clock::now();
     if (now > due + std::chrono::milliseconds(250)) {
       t0 += now - due;  // behind (a busy machine): shift the schedule, no burst
     } else {
       std::this_thread::sleep_until(due);
     }
-    std_msgs::msg::Float64 rudder;
-    rudder.data(o.rudder_sign * row.delta);
-    sensor_msgs::msg::Imu imu;
-    set_stamp(&imu.header(), row.t);
-    imu.header().frame_id("imu_link");
-    imu.orientation().w(1.0);
-    imu.orientation_covariance()[0] = -1.0;  // no orientation estimate
-    imu.angular_velocity().z(-row.r);        // REP 103: z up
-    geometry_msgs::msg::TwistStamped twist;
-    set_stamp(&twist.header(), row.t);
-    twist.header().frame_id("base_link");
-    twist.twist().linear().x(1.0);
-    twist.twist().linear().y(-row.v);  // REP 103: y to port
-    twist.twist().angular().z(-row.r);
-    rudder_w->write(&rudder);
-    imu_w->write(&imu);
-    if (o.odometry.empty()) {
-      twist_w->write(&twist);
+    if (o.burst == 1) {
+      write_at(rudder_w, &burst[0].rudder, 0.0);
+      write_at(imu_w, &burst[0].imu, 0.0);
+      write_sway(burst[0], 0.0);
     } else {
-      nav_msgs::msg::Odometry odom;
-      odom.header(twist.header());
-      odom.header().frame_id("odom");
-      odom.child_frame_id("base_link");
-      odom.pose().pose().orientation().w(1.0);
-      odom.twist().twist(twist.twist());
-      twist_w->write(&odom);
+      // The instants' source times, 1/rate apart (wall time) up to now; each rudder angle
+      // 1 ms before its Imu sample.
+      const double wall_now =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+              .count();
+      const double step = 1.0 / (50.0 * o.speed);
+      for (std::size_t j = 0; j < burst.size(); ++j) {
+        burst[j].sent = wall_now - static_cast<double>(burst.size() - 1 - j) * step;
+      }
+      for (Instant& b : burst) {
+        write_at(imu_w, &b.imu, b.sent + 1e-3);
+        write_sway(b, b.sent + 1e-3);
+      }
+      for (Instant& b : burst) write_at(rudder_w, &b.rudder, b.sent);
     }
-    ++n_pub;
+    burst.clear();
   }
   rudder_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2.0));
   std::printf("published %llu\n", static_cast<unsigned long long>(n_pub));

@@ -8,6 +8,8 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <memory>
@@ -18,6 +20,8 @@
 
 #include "fleet.hpp"
 #include "test_env.hpp"
+#include "usv_fdi/core/simulator.hpp"
+#include "usv_fdi/core/vessel.hpp"
 
 namespace usvfdi::dds::test {
 namespace {
@@ -287,6 +291,71 @@ TEST(Ros2EndToEnd, OdometrySwayFromSensorDataPublishersIsolatesBothFaults) {
   const auto from = log.rfind(", ", at);
   ASSERT_NE(from, std::string::npos) << log;
   EXPECT_GE(std::stoul(log.substr(from + 2, at - from - 2)), 4000u) << log;  // 100 s at 50 Hz
+}
+
+TEST(Ros2EndToEnd, RudderAnglesDeliveredAfterTheirImuSamplesArePairedWithTheirOwnInstant) {
+  // GIVEN the adapter (RELIABLE writers) and a reader of the rudder samples it writes for the
+  // sidecar
+  Fleet f;
+  const unsigned m = 257100043;
+  const std::string ms = std::to_string(m);
+  f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "-1", "--reliable", "--no-mirrors"});
+  ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
+  ChildProcess& inputs = f.start_probe("inputs", "read-inputs", {"--mmsi", ms, "--timeout", "170"});
+  ASSERT_TRUE(inputs.read_line(seconds(20)).value_or("") == "reading") << f.log("inputs");
+  // WHEN a ROS 2 node's samples reach the adapter in bursts of 10 instants, the rudder angles
+  // (std_msgs/Float64, no header) after the Imu and twist samples they go with: the order a
+  // reader whose delivery thread fell behind sees (each topic's reader delivers on its own)
+  Ros2Probe pub(f, "pub", "publish-paper",
+                {"--speed", "4", "--rudder-sign", "-1", "--burst", "10"});
+  // THEN each INS sample's rudder angle (stamped with the Imu stamp) is the one of its own
+  // instant, as the simulator made it (the adapter pairs on the writers' source timestamps;
+  // pairing on arrival gave every sample of a burst the previous burst's last angle). The
+  // adapter's readers are BEST_EFFORT: a rudder sample lost on a busy machine leaves its Imu
+  // sample the angle before, so a few may differ.
+  std::map<long long, double> delta;  // by sample number t * 50
+  std::string text;
+  // (read while the node publishes: a full pipe would stall the reader, and its history
+  // would then drop samples)
+  const auto end = Clock::now() + seconds(150);
+  while (Clock::now() < end) {
+    const auto line = inputs.read_line(milliseconds(3000));
+    if (!line) {  // quiet: the node is done and the adapter has flushed what it had
+      if (pub.process().wait_exit(milliseconds(0)).has_value()) break;
+      continue;
+    }
+    text += *line + "\n";
+    double stamp = 0.0, d = 0.0;
+    int valid = 0;
+    if (std::sscanf(line->c_str(), "rudder stamp=%lf delta=%lf valid=%d", &stamp, &d, &valid) ==
+        3) {
+      delta[std::llround(stamp * 50.0)] = d;
+    }
+  }
+  inputs.signal(SIGTERM);
+  ASSERT_TRUE(pub.process().wait_exit(seconds(10)).has_value()) << f.log("pub");
+  EXPECT_EQ(*pub.process().wait_exit(milliseconds(0)), 0) << f.log("pub");
+  usvfdi::SimConfig cfg = usvfdi::paper_scenario(usvfdi::otter(), 50.0, 1);
+  cfg.sigma_v = 0.0;
+  cfg.sigma_r = 0.0;
+  usvfdi::Simulator sim(cfg);
+  usvfdi::SimRow row;
+  std::size_t rows = 0, exact = 0;
+  while (sim.next(&row)) {
+    ++rows;
+    const auto it = delta.find(std::llround(row.t * 50.0));
+    if (it != delta.end() && it->second == row.delta) ++exact;
+  }
+  std::printf("%zu of %zu rudder samples carry their own instant's angle (%zu instants)\n", exact,
+              delta.size(), rows);
+  EXPECT_GE(delta.size(), rows * 8 / 10)
+      << "rudder samples written for " << delta.size() << " of " << rows << " instants\n"
+      << f.log("ros2");
+  EXPECT_GE(exact, delta.size() * 95 / 100)
+      << exact << " of " << delta.size() << " rudder samples carry their own instant's angle\n"
+      << text.substr(0, 2000) << f.log("ros2");
+  f.process("ros2").signal(SIGTERM);
+  ASSERT_TRUE(f.process("ros2").wait_exit(seconds(10)).has_value());
 }
 
 }  // namespace

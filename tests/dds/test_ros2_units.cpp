@@ -56,19 +56,25 @@ TEST(Ros2Topics, AbsoluteAndRelativeNamesMapToRt) {
   EXPECT_EQ(dds_topic_of("/2imu"), "");
 }
 
-YawSample yaw(double t, double r, double delta = 0.1) {
+/// An Imu sample written at its stamp (source timestamp = header stamp).
+YawSample yaw(double t, double r) {
   YawSample y;
   y.stamp = t;
+  y.sent = t;
   y.r = r;
   y.r_valid = true;
-  y.rudder = true;
-  y.delta = delta;
-  y.delta_valid = true;
   return y;
 }
 
+/// An assembler that has the rudder angle 0.1 written at `t` (before the Imu samples after it).
+InsAssembler with_rudder(const AssemblyParams& p, double t = 0.0) {
+  InsAssembler a(p);
+  a.add_rudder(t, 0.1, true);
+  return a;
+}
+
 TEST(Ros2Assembly, AnImuSampleWaitsForTheSwaySampleOfItsStamp) {
-  InsAssembler a(AssemblyParams{});
+  InsAssembler a = with_rudder(AssemblyParams{}, 1.00);
   a.add_yaw(yaw(1.00, 0.01), 0.0);
   EXPECT_TRUE(a.release(0.01).empty()) << "no sway sample at or after 1.00 yet";
   a.add_sway(1.00, 0.3);
@@ -83,7 +89,7 @@ TEST(Ros2Assembly, AnImuSampleWaitsForTheSwaySampleOfItsStamp) {
 }
 
 TEST(Ros2Assembly, BetweenTwoSwaySamplesVIsInterpolated) {
-  InsAssembler a(AssemblyParams{});
+  InsAssembler a = with_rudder(AssemblyParams{}, 1.05);
   a.add_sway(1.0, 0.2);
   a.add_yaw(yaw(1.05, 0.0), 0.0);
   a.add_sway(1.1, 0.4);
@@ -97,7 +103,7 @@ TEST(Ros2Assembly, AfterThePairWaitTheLatestSwayIsHeldUntilItIsStale) {
   AssemblyParams p;
   p.sway_max_age = 0.2;
   p.pair_wait = 0.1;
-  InsAssembler a(p);
+  InsAssembler a = with_rudder(p, 1.25);
   a.add_sway(1.0, 0.2);
   a.add_yaw(yaw(1.15, 0.0), 0.0);  // 0.15 s after the last sway sample: held
   a.add_yaw(yaw(1.25, 0.0), 0.0);  // 0.25 s: stale
@@ -123,7 +129,7 @@ TEST(Ros2Assembly, NoSwayAtAllGivesInvalidVButKeepsR) {
 }
 
 TEST(Ros2Assembly, SamplesLeaveInArrivalOrderAndBackwardSwayStampsAreRefused) {
-  InsAssembler a(AssemblyParams{});
+  InsAssembler a = with_rudder(AssemblyParams{}, 0.08);
   for (int k = 0; k < 5; ++k) a.add_yaw(yaw(0.02 * k, 0.001 * k), 0.0);
   for (int k = 0; k < 5; ++k) a.add_sway(0.02 * k, 0.1 * k);
   a.add_sway(0.02, 9.0);  // backward
@@ -135,6 +141,72 @@ TEST(Ros2Assembly, SamplesLeaveInArrivalOrderAndBackwardSwayStampsAreRefused) {
     EXPECT_DOUBLE_EQ(out[k].stamp, 0.02 * k);
     EXPECT_NEAR(out[k].v, 0.1 * k, 1e-12);
   }
+}
+
+TEST(Ros2Assembly, TheRudderAngleIsPairedOnTheWritersClockNotInTheOrderOfArrival) {
+  // GIVEN an autopilot that writes the rudder angle just before each Imu sample, and readers
+  // that deliver a burst of Imu and sway samples before the rudder angles written among them
+  // (each topic's reader has its own delivery thread)
+  AssemblyParams p;
+  InsAssembler a(p);
+  a.add_rudder(-0.001, -1.0, true);
+  for (int k = 0; k < 5; ++k) {
+    a.add_yaw(yaw(0.02 * k, 0.0), 0.0);
+    a.add_sway(0.02 * k, 0.0);
+  }
+  // THEN the Imu samples wait for the rudder stream rather than take the stale angle
+  EXPECT_TRUE(a.release(0.01).empty());
+  for (int k = 0; k < 5; ++k) a.add_rudder(0.02 * k - 0.001, 0.01 * k, true);
+  // (the last one waits for the next angle: one written before 0.08 s may still be on its way)
+  auto out = a.release(0.02);
+  EXPECT_EQ(out.size(), 4u);
+  a.add_rudder(0.099, 0.05, true);
+  for (const AssembledSample& s : a.release(0.02)) out.push_back(s);
+  // AND each gets the angle written just before it
+  ASSERT_EQ(out.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_TRUE(out[k].rudder);
+    EXPECT_TRUE(out[k].delta_valid);
+    EXPECT_DOUBLE_EQ(out[k].delta, 0.01 * k) << "Imu sample " << k;
+  }
+  EXPECT_EQ(a.without_rudder(), 0u);
+}
+
+TEST(Ros2Assembly, AnImuSampleWaitsForTheRudderOnlyUpToThePairWait) {
+  // GIVEN a rudder angle written at 0 s and nothing since
+  AssemblyParams p;
+  p.pair_wait = 0.2;
+  p.rudder_max_age = 1.0;
+  InsAssembler a = with_rudder(p, 0.0);
+  a.add_sway(0.5, 0.0);
+  a.add_sway(1.5, 0.0);
+  a.add_yaw(yaw(0.5, 0.0), 10.0);
+  a.add_yaw(yaw(1.5, 0.0), 10.0);
+  // THEN they wait for a later angle for pair_wait of wall time
+  EXPECT_TRUE(a.release(10.1).empty());
+  const auto out = a.release(10.25);
+  ASSERT_EQ(out.size(), 2u);
+  // AND then go with the last angle while it is at most rudder_max_age older, else without
+  EXPECT_TRUE(out[0].rudder);
+  EXPECT_DOUBLE_EQ(out[0].delta, 0.1);
+  EXPECT_FALSE(out[1].rudder) << "written 1.5 s before the Imu sample";
+  EXPECT_EQ(a.without_rudder(), 1u);
+}
+
+TEST(Ros2Assembly, RudderAnglesOfTwoWritersAreOrderedByTheirSourceTime) {
+  InsAssembler a(AssemblyParams{});
+  a.add_rudder(0.10, 0.3, true);
+  a.add_rudder(0.05, 0.2, true);  // written earlier, arrived later
+  a.add_rudder(0.20, kNaN, false);
+  a.add_sway(0.07, 0.0);
+  a.add_sway(0.20, 0.0);
+  a.add_yaw(yaw(0.07, 0.0), 0.0);
+  a.add_yaw(yaw(0.20, 0.0), 0.0);
+  const auto out = a.release(0.0);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_DOUBLE_EQ(out[0].delta, 0.2);
+  EXPECT_TRUE(out[1].rudder) << "a rudder sample goes with it, marked invalid";
+  EXPECT_FALSE(out[1].delta_valid);
 }
 
 Row row(Sensor s, FaultState st) {
