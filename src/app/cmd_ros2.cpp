@@ -342,6 +342,12 @@ usv_fdi_msgs::msg::FdiStatus mirror_of(const fdi::FdiStatus& s) {
   m.surge_speed(s.surge_speed());
   m.speed_ratio(s.speed_ratio());
   m.reference_speed(s.reference_speed());
+  m.j_peak(s.j_peak());
+  m.j_raise(s.j_raise());
+  m.j_leave(s.j_leave());
+  m.c_a(s.c_a());
+  m.c_g(s.c_g());
+  m.model_mismatch(s.model_mismatch());
   return m;
 }
 

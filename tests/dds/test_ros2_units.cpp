@@ -3,7 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "ros2_adapter.hpp"
 
@@ -207,6 +211,60 @@ TEST(Ros2Assembly, RudderAnglesOfTwoWritersAreOrderedByTheirSourceTime) {
   EXPECT_DOUBLE_EQ(out[0].delta, 0.2);
   EXPECT_TRUE(out[1].rudder) << "a rudder sample goes with it, marked invalid";
   EXPECT_FALSE(out[1].delta_valid);
+}
+
+/// The field names of `struct name { ... }` in an IDL file, in order (comments dropped; the
+/// IDL escape of a keyword, "_sequence", as the ROS mirror names it: "sequence_number").
+std::vector<std::string> idl_fields(const std::string& file, const std::string& name) {
+  std::ifstream in(file);
+  EXPECT_TRUE(in) << file;
+  std::vector<std::string> out;
+  std::string line;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    line = line.substr(0, line.find("//"));
+    if (!inside) {
+      inside = line.find("struct " + name) != std::string::npos &&
+               line.find("struct " + name + "_") == std::string::npos;
+      continue;
+    }
+    if (line.find("};") != std::string::npos) break;
+    const auto semi = line.find(';');
+    if (semi == std::string::npos) continue;
+    std::string decl = line.substr(0, semi);
+    decl = decl.substr(0, decl.find('['));
+    std::string field = decl.substr(decl.find_last_of(" \t") + 1);
+    if (field == "_sequence") field = "sequence_number";
+    out.push_back(field);
+  }
+  return out;
+}
+
+/// The field names of a ROS 2 .msg file, in order (constants, NAME=value, left out).
+std::vector<std::string> msg_fields(const std::string& file) {
+  std::ifstream in(file);
+  EXPECT_TRUE(in) << file;
+  std::vector<std::string> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line.substr(0, line.find('#')));
+    std::string type, field;
+    if (words >> type >> field && field.find('=') == std::string::npos) out.push_back(field);
+  }
+  return out;
+}
+
+TEST(Ros2Mirrors, CarryEveryFieldOfTheKeyedTypesInTheirOrder) {
+  // The keyless mirrors (idl/ros2/usv_fdi_msgs.idl) and the ROS 2 interface package a ROS 2
+  // host builds (ros2/usv_fdi_msgs/msg) follow fdi::FaultEvent and fdi::FdiStatus field for
+  // field: a field added to a keyed type (FdiStatus version 4) must reach ROS 2 tools too.
+  const std::string src = USV_FDI_SOURCE_DIR;
+  for (const std::string type : {"FaultEvent", "FdiStatus"}) {
+    const auto keyed = idl_fields(src + "/idl/usv_fdi.idl", type);
+    EXPECT_GE(keyed.size(), 10u) << type;
+    EXPECT_EQ(idl_fields(src + "/idl/ros2/usv_fdi_msgs.idl", type), keyed) << type;
+    EXPECT_EQ(msg_fields(src + "/ros2/usv_fdi_msgs/msg/" + type + ".msg"), keyed) << type;
+  }
 }
 
 Row row(Sensor s, FaultState st) {
