@@ -37,6 +37,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -75,42 +76,73 @@ struct DashboardArgs {
   bool tls() const { return !tls_cert.empty(); }
 };
 
-/// What the HTTP threads share with the DDS thread: the latest board and the acks asked for.
+/// What the HTTP threads share with the DDS thread: the boards (deltas, and the whole board
+/// when a page or GET /api/board asks for it) and the acks asked for.
 class Hub {
  public:
-  void publish(db::BoardFrame frame) {
+  /// A new board, as the change from the one before (every live page's next message).
+  void publish_delta(std::string delta) {
     {
       std::lock_guard<std::mutex> l(m_);
-      board_ = std::move(frame.full);
       ++version_;
-      deltas_.emplace_back(version_, std::move(frame.delta));
+      deltas_.emplace_back(version_, std::move(delta));
       while (deltas_.size() > kDeltas) deltas_.pop_front();
     }
     cv_.notify_all();
   }
+  /// The whole board as of the latest delta, built because someone asked (full_wanted()).
+  void publish_full(std::string full) {
+    {
+      std::lock_guard<std::mutex> l(m_);
+      full_ = std::move(full);
+      full_version_ = version_;
+      want_full_ = false;
+    }
+    cv_.notify_all();
+  }
+  /// Whether a page or a request waits for the whole board (the DDS thread builds it then).
+  bool full_wanted() {
+    std::lock_guard<std::mutex> l(m_);
+    return want_full_;
+  }
   /// Waits up to `timeout` for a board newer than *seen; true and the server-sent events that
-  /// bring a page from board *seen to the newest: the deltas since, or the whole board when
-  /// the page has none yet, is further behind than the deltas kept or the deltas since would
-  /// be longer than it.
+  /// bring a page from board *seen to the newest: the deltas since, or, for a page that has no
+  /// board yet or is further behind than the deltas kept, the whole board and the deltas after
+  /// it (the whole board is asked of the DDS thread when the last one built is too old).
   bool next(std::uint64_t* seen, std::string* out, std::chrono::milliseconds timeout) {
     std::unique_lock<std::mutex> l(m_);
-    cv_.wait_for(l, timeout, [&] { return stop_ || version_ > *seen; });
-    if (stop_ || version_ <= *seen) return false;
-    out->clear();
-    if (*seen > 0 && !deltas_.empty() && deltas_.front().first <= *seen + 1) {
-      for (const auto& [version, delta] : deltas_) {
-        if (version > *seen) *out += "data: " + delta + "\n\n";
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+      if (stop_) return false;
+      if (version_ > *seen) {
+        out->clear();
+        if (*seen > 0 && kept_after(*seen)) {
+          append_deltas_after(*seen, out);
+          *seen = version_;
+          return true;
+        }
+        if (full_version_ > 0 && kept_after(full_version_) &&
+            version_ - full_version_ <= kFullLag) {
+          *out = "data: " + full_ + "\n\n";
+          append_deltas_after(full_version_, out);
+          *seen = version_;
+          return true;
+        }
+        want_full_ = true;
       }
+      if (cv_.wait_until(l, until) == std::cv_status::timeout) return false;
     }
-    // A page further behind than the deltas kept, or whose deltas would weigh more than the
-    // whole board, gets the whole board.
-    if (out->empty() || out->size() > board_.size()) *out = "data: " + board_ + "\n\n";
-    *seen = version_;
-    return true;
   }
-  std::string current() {
-    std::lock_guard<std::mutex> l(m_);
-    return board_;
+  /// The whole board as of now (GET /api/board): asks the DDS thread for it and waits up to
+  /// `timeout` (then the last one built).
+  std::string current(std::chrono::milliseconds timeout) {
+    std::unique_lock<std::mutex> l(m_);
+    const std::uint64_t asked = version_;
+    if (full_version_ < asked) {
+      want_full_ = true;
+      cv_.wait_for(l, timeout, [&] { return stop_ || full_version_ >= asked; });
+    }
+    return full_;
   }
   void set_metrics(std::string text) {
     std::lock_guard<std::mutex> l(m_);
@@ -162,11 +194,26 @@ class Hub {
   }
 
  private:
+  /// Whether the deltas after version v are all kept.
+  bool kept_after(std::uint64_t v) const {
+    return v == version_ || (!deltas_.empty() && deltas_.front().first <= v + 1);
+  }
+  void append_deltas_after(std::uint64_t v, std::string* out) const {
+    for (const auto& [version, delta] : deltas_) {
+      if (version > v) *out += "data: " + delta + "\n\n";
+    }
+  }
+
   std::mutex m_;
   std::condition_variable cv_;
-  std::string board_ = "{}";
+  std::string full_ = "{}";
+  std::uint64_t full_version_ = 0;  ///< the delta the whole board is as of (0: none yet)
+  bool want_full_ = false;
   std::deque<std::pair<std::uint64_t, std::string>> deltas_;  ///< (version, delta), newest last
   static constexpr std::size_t kDeltas = 16;
+  /// A page that joins takes the last whole board with at most this many deltas after it;
+  /// older: a new one is built.
+  static constexpr std::uint64_t kFullLag = 4;
   std::string metrics_;
   std::uint64_t version_ = 0;
   bool stop_ = false;
@@ -297,7 +344,7 @@ void routes(httplib::Server& svr, Hub& hub, const DashboardArgs& a,
           [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
   svr.Get("/api/board", [&hub](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");
-    res.set_content(hub.current(), "application/json");
+    res.set_content(hub.current(std::chrono::milliseconds(2000)), "application/json");
   });
   // Who the page's user is and whether they may acknowledge.
   svr.Get("/api/me", [auth, &a](const httplib::Request& req, httplib::Response& res) {
@@ -613,29 +660,78 @@ class Acks {
   bool changed_ = false;
 };
 
-db::BoardInput board_input(const FleetView& view) {
-  db::BoardInput in;
-  view.rows().for_each([&](const RowKey& k, const Row& r) { in.rows[k] = r; });
-  if (view.vessels() != nullptr) {
-    view.vessels()->for_each(
-        [&](const std::uint32_t& m, const VesselStatus& v) { in.statuses[m] = v; });
+bool same_row(const Row& a, const Row& b) {
+  return a.ev.sequence == b.ev.sequence && a.ev.incarnation == b.ev.incarnation &&
+         a.ev.state == b.ev.state && a.written == b.written && a.alive == b.alive &&
+         a.writer == b.writer;
+}
+bool same_status(const VesselStatus& a, const VesselStatus& b) {
+  return a.written == b.written && a.alive == b.alive && a.writer == b.writer;
+}
+
+/// Brings `mine` (kept between boards) to what the view shows: copies the samples that
+/// changed, drops those the view no longer shows, and adds their vessels to *touched.
+template <class K, class V, class Same>
+void refresh(const InstanceOwners<K, V>& view, std::map<K, V>* mine, Same same,
+             std::set<std::uint32_t>* touched) {
+  const auto vessel = [](const K& k) -> std::uint32_t {
+    if constexpr (std::is_same_v<K, RowKey>) {
+      return k.first;
+    } else {
+      return k;
+    }
+  };
+  std::size_t shown = 0;
+  view.for_each([&](const K& k, const V& v) {
+    ++shown;
+    const auto it = mine->find(k);
+    if (it == mine->end()) {
+      mine->emplace(k, v);
+    } else if (!same(it->second, v)) {
+      it->second = v;
+    } else {
+      return;
+    }
+    touched->insert(vessel(k));
+  });
+  if (shown == mine->size()) return;
+  std::set<K> keys;
+  view.for_each([&](const K& k, const V&) { keys.insert(k); });
+  for (auto it = mine->begin(); it != mine->end();) {
+    if (keys.count(it->first) > 0) {
+      ++it;
+      continue;
+    }
+    touched->insert(vessel(it->first));
+    it = mine->erase(it);
   }
+}
+
+/// Brings `in` (kept between boards) to the fleet view: the rows and statuses that changed
+/// (their vessels into *touched), the liveness, the roster and the counts afresh. (Copying the
+/// whole view, 1000 vessels, took 4-8 ms on every change.)
+void refresh_board_input(const FleetView& view, db::BoardInput* in,
+                         std::set<std::uint32_t>* touched) {
+  refresh(view.rows(), &in->rows, same_row, touched);
+  if (view.vessels() != nullptr) refresh(*view.vessels(), &in->statuses, same_status, touched);
   const double mono = mono_now();
+  in->heard_age.clear();
+  in->silent.clear();
   for (const std::uint32_t m : view.liveness().vessels()) {
-    in.heard_age[m] = view.liveness().age(m, mono);
-    in.silent[m] = view.liveness().silent(m);
+    in->heard_age[m] = view.liveness().age(m, mono);
+    in->silent[m] = view.liveness().silent(m);
   }
-  in.roster_never_heard = view.roster().never_heard(view.liveness());
-  in.silent_after = view.liveness().silent_after();
-  in.conflicts = view.conflicts();
-  return in;
+  in->roster_never_heard = view.roster().never_heard(view.liveness());
+  in->silent_after = view.liveness().silent_after();
+  in->conflicts = view.conflicts();
 }
 
 /// The DDS thread's loop: the fleet view, the acks, the board; until a stop signal or the
 /// credentials expire. Returns the exit code.
 int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& events, Acks& acks,
-          Hub& hub, db::BoardFramer& framer, const CredentialExpiry& expiry) {
+          Hub& hub, db::BoardFramer& framer, db::BoardInput& in, const CredentialExpiry& expiry) {
   double last_board = mono_now(), last_metrics = last_board;
+  std::set<std::uint32_t> touched;
   for (;;) {
     bool changed = view.poll(0.1);
     for (const db::AckWork& w : hub.take_asked()) acks.ask(w);
@@ -643,9 +739,11 @@ int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& event
     const double now = mono_now();
     const bool board = changed || now - last_board >= 1.0, metrics = now - last_metrics >= 1.0;
     if (board || metrics) {
-      const db::BoardInput in = board_input(view);
+      refresh_board_input(view, &in, &touched);
       if (board) {
-        hub.publish(framer.frame(in, events, acks.outcomes(), wall_now(), !a.read_only));
+        hub.publish_delta(
+            framer.delta(in, &touched, events, acks.outcomes(), wall_now(), !a.read_only));
+        touched.clear();
         last_board = now;
       }
       // The metrics once a second (a scrape is seconds apart), not on every change.
@@ -653,6 +751,10 @@ int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& event
         hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
         last_metrics = now;
       }
+    }
+    // The whole board only when a page that joins or GET /api/board asks for it.
+    if (hub.full_wanted()) {
+      hub.publish_full(framer.full(in, events, acks.outcomes(), wall_now(), !a.read_only));
     }
     if (expiry.expired(wall_now())) {
       spdlog::error("{}", expired_message(expiry));
@@ -724,9 +826,12 @@ int run_dashboard(DashboardArgs& a) {
   });
   Hub hub;
   db::BoardFramer framer;
+  db::BoardInput in;  // the fleet view as the board last saw it (refresh_board_input)
   {
-    const db::BoardInput in = board_input(*view);
-    hub.publish(framer.frame(in, events, acks.outcomes(), wall_now(), !a.read_only));
+    std::set<std::uint32_t> touched;
+    refresh_board_input(*view, &in, &touched);
+    hub.publish_delta(framer.delta(in, nullptr, events, acks.outcomes(), wall_now(), !a.read_only));
+    hub.publish_full(framer.full(in, events, acks.outcomes(), wall_now(), !a.read_only));
     hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
   }
 
@@ -765,7 +870,7 @@ int run_dashboard(DashboardArgs& a) {
                     : std::string("no sign-in"),
                ctx->config().domain_id);
   try {
-    rc = serve(a, *view, events, acks, hub, framer, expiry);
+    rc = serve(a, *view, events, acks, hub, framer, in, expiry);
   } catch (const std::exception& e) {
     spdlog::error("dashboard: {}", e.what());
     rc = kExitFailure;

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -118,6 +120,14 @@ nlohmann::json without_event_ages(nlohmann::json j) {
   return j;
 }
 
+/// board_json and the can_ack the framer's boards carry.
+nlohmann::json board_json_with_can_ack(const BoardInput& in, const EventHistory& h,
+                                       const std::deque<AckOutcome>& acks, double now) {
+  nlohmann::json j = board_json(in, h, acks, now);
+  j["can_ack"] = true;
+  return j;
+}
+
 TEST(DashboardBoard, DeltasCarryOnlyWhatChangedAndApplyToTheNextBoard) {
   BoardFramer framer;
   EventHistory h(3);
@@ -180,6 +190,55 @@ TEST(DashboardBoard, DeltasCarryOnlyWhatChangedAndApplyToTheNextBoard) {
   EXPECT_EQ(without_event_ages(board), without_event_ages(nlohmann::json::parse(f.full)))
       << board.dump() << "\n"
       << f.full;
+}
+
+TEST(DashboardBoard, ADeltaRebuildsOnlyTheVesselsThatChanged) {
+  // GIVEN a fleet of 1000 vessels, each with a status, framed once
+  BoardFramer framer;
+  EventHistory h;
+  std::deque<AckOutcome> acks;
+  BoardInput in;
+  for (std::uint32_t m = 1; m <= 1000; ++m) {
+    in.heard_age[m] = 0.5;
+    in.silent[m] = false;
+    in.statuses[m].written = 50.0;
+    in.statuses[m].st.mmsi(m);
+  }
+  EXPECT_EQ(
+      nlohmann::json::parse(framer.delta(in, nullptr, h, acks, 100.0, true))["vessels"].size(),
+      1000u);
+  EXPECT_EQ(framer.rebuilt(), 1000u);
+  nlohmann::json board = nlohmann::json::parse(framer.full(in, h, acks, 100.0, true));
+  // WHEN vessel 7 raises (its row touched), vessel 9's status moves on and vessel 3 falls silent
+  const Row g7 = row(7, Sensor::kGyro, FaultState::kRaised, 1, 100.5);
+  in.rows[{7, static_cast<int>(Sensor::kGyro)}] = g7;
+  h.add(g7);
+  in.statuses[9].st.armed(true);
+  in.statuses[9].written = 51.0;
+  in.silent[3] = true;
+  const std::set<std::uint32_t> touched{7, 9};
+  const nlohmann::json d = nlohmann::json::parse(framer.delta(in, &touched, h, acks, 101.0, true));
+  // THEN only those three entries were built again, and the delta carries them
+  EXPECT_EQ(framer.rebuilt(), 3u);
+  std::vector<std::uint32_t> carried;
+  for (const auto& v : d["vessels"]) carried.push_back(v["mmsi"].get<std::uint32_t>());
+  EXPECT_EQ(carried, (std::vector<std::uint32_t>{3, 7, 9}));
+  EXPECT_EQ(d["vessels"][1]["sensors"]["gyro"]["state"], "raised");
+  EXPECT_DOUBLE_EQ(d["vessels"][1]["sensors"]["gyro"]["age_s"].get<double>(), 0.5);
+  EXPECT_TRUE(d["vessels"][2]["status"]["armed"].get<bool>());
+  // AND the whole board built on demand is the one the deltas put together
+  const nlohmann::json full = nlohmann::json::parse(framer.full(in, h, acks, 101.0, true));
+  EXPECT_EQ(without_event_ages(apply_delta(board, d)), without_event_ages(full));
+  EXPECT_EQ(full, board_json_with_can_ack(in, h, acks, 101.0));
+  // WHEN nothing is touched, THEN nothing is built again
+  framer.delta(in, &touched, h, acks, 102.0, true);
+  EXPECT_EQ(framer.rebuilt(), 2u) << "the touched ones, found unchanged";
+  framer.delta(in, nullptr, h, acks, 102.0, true);
+  EXPECT_EQ(framer.rebuilt(), 1000u);
+  const std::set<std::uint32_t> none;
+  const nlohmann::json quiet = nlohmann::json::parse(framer.delta(in, &none, h, acks, 103.0, true));
+  EXPECT_EQ(framer.rebuilt(), 0u);
+  EXPECT_TRUE(quiet["vessels"].empty());
 }
 
 TEST(DashboardMetrics, TheFleetIsExposedInPrometheusTextForm) {

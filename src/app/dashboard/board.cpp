@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 #include <vector>
@@ -73,6 +74,7 @@ json status_json(const VesselStatus& v) {
               {"samples", s.samples()},
               {"dropped", s.dropped()},
               {"message", escape_text(s.message().to_string())},
+              {"model_mismatch", s.model_mismatch()},
               {"surge_speed", num(s.surge_speed())},
               {"speed_ratio", num(s.speed_ratio())},
               {"written", num(v.written)},
@@ -168,28 +170,37 @@ std::set<std::uint32_t> board_vessels(const BoardInput& in) {
 
 namespace {
 
-/// Every vessel's entry on the board, by MMSI (rows grouped in one pass, not per vessel).
-std::vector<std::pair<std::uint32_t, json>> vessel_entries(const BoardInput& in, double now) {
-  std::map<std::uint32_t, json> sensors;
-  for (const auto& [key, row] : in.rows) {
-    sensors[key.first][to_string(row.ev.sensor)] = row_json(row, now);
+/// One vessel's entry on the board without its ages (heard_age_s, the sensors' age_s).
+json bare_entry(std::uint32_t m, const BoardInput& in, bool silent, bool never_heard) {
+  json sensors = json::object();
+  for (auto it = in.rows.lower_bound(RowKey{m, std::numeric_limits<int>::min()});
+       it != in.rows.end() && it->first.first == m; ++it) {
+    json r = row_json(it->second, 0.0);
+    r.erase("age_s");
+    sensors[to_string(it->second.ev.sensor)] = std::move(r);
   }
-  const std::set<std::uint32_t> never(in.roster_never_heard.begin(), in.roster_never_heard.end());
-  std::vector<std::pair<std::uint32_t, json>> out;
-  for (const std::uint32_t m : board_vessels(in)) {
-    json v{{"mmsi", m}};
-    const auto se = sensors.find(m);
-    v["sensors"] = se == sensors.end() ? json::object() : std::move(se->second);
-    const auto st = in.statuses.find(m);
-    v["status"] = st == in.statuses.end() ? json(nullptr) : status_json(st->second);
-    const auto age = in.heard_age.find(m);
-    v["heard_age_s"] = age == in.heard_age.end() ? json(nullptr) : num(age->second);
-    const auto sil = in.silent.find(m);
-    v["silent"] = sil != in.silent.end() && sil->second;
-    v["never_heard"] = never.count(m) > 0;
-    out.emplace_back(m, std::move(v));
+  json v{{"mmsi", m}, {"sensors", std::move(sensors)}};
+  const auto st = in.statuses.find(m);
+  v["status"] = st == in.statuses.end() ? json(nullptr) : status_json(st->second);
+  v["silent"] = silent;
+  v["never_heard"] = never_heard;
+  return v;
+}
+
+/// An entry with its ages at `now`: the vessel's heard age, each sensor's now - written.
+json with_ages(json v, const BoardInput& in, double now) {
+  const auto age = in.heard_age.find(v["mmsi"].get<std::uint32_t>());
+  v["heard_age_s"] = age == in.heard_age.end() ? json(nullptr) : num(age->second);
+  for (auto& [sensor, r] : v["sensors"].items()) {
+    const json& w = r["written"];
+    r["age_s"] = w.is_number() ? num(now - w.get<double>()) : json(nullptr);
   }
-  return out;
+  return v;
+}
+
+bool is_silent(const BoardInput& in, std::uint32_t m) {
+  const auto sil = in.silent.find(m);
+  return sil != in.silent.end() && sil->second;
 }
 
 json ack_list_json(const std::deque<AckOutcome>& acks) {
@@ -220,52 +231,82 @@ json board_fields(const BoardInput& in, double now, const std::deque<AckOutcome>
 
 json board_json(const BoardInput& in, const EventHistory& events,
                 const std::deque<AckOutcome>& acks, double now) {
+  const std::set<std::uint32_t> never(in.roster_never_heard.begin(), in.roster_never_heard.end());
   json vessels = json::array();
-  for (auto& [m, v] : vessel_entries(in, now)) vessels.push_back(std::move(v));
+  for (const std::uint32_t m : board_vessels(in)) {
+    vessels.push_back(with_ages(bare_entry(m, in, is_silent(in, m), never.count(m) > 0), in, now));
+  }
   json board = board_fields(in, now, acks);
   board["vessels"] = std::move(vessels);
   board["events"] = events.to_json(now);
   return board;
 }
 
-BoardFrame BoardFramer::frame(const BoardInput& in, const EventHistory& events,
-                              const std::deque<AckOutcome>& acks, double now, bool can_ack) {
-  json vessels = json::array(), changed = json::array(), removed = json::array();
-  json ages = json::object();
-  std::map<std::uint32_t, std::string> keys;
-  for (auto& [m, v] : vessel_entries(in, now)) {
-    // what the entry says besides its ages, which move on with every board
-    json bare = v;
-    bare.erase("heard_age_s");
-    for (auto& [sensor, row] : bare["sensors"].items()) row.erase("age_s");
-    std::string key = dump(bare);
-    const auto was = keys_.find(m);
-    if (was == keys_.end() || was->second != key) changed.push_back(v);
-    keys.emplace(m, std::move(key));
+std::string BoardFramer::delta(const BoardInput& in, const std::set<std::uint32_t>* touched,
+                               const EventHistory& events, const std::deque<AckOutcome>& acks,
+                               double now, bool can_ack) {
+  const std::set<std::uint32_t> vessels = board_vessels(in);
+  const std::set<std::uint32_t> never(in.roster_never_heard.begin(), in.roster_never_heard.end());
+  json changed = json::array(), removed = json::array(), ages = json::object();
+  rebuilt_ = 0;
+  for (const std::uint32_t m : vessels) {
+    const bool silent = is_silent(in, m), never_heard = never.count(m) > 0;
+    auto it = entries_.find(m);
+    const bool stale = it == entries_.end() || touched == nullptr || touched->count(m) > 0 ||
+                       it->second.silent != silent || it->second.never_heard != never_heard;
+    if (stale) {
+      ++rebuilt_;
+      json bare = bare_entry(m, in, silent, never_heard);
+      std::string key = dump(bare);
+      // (what the entry says besides its ages, which move on with every board)
+      if (it == entries_.end() || it->second.key != key) {
+        changed.push_back(with_ages(bare, in, now));
+        entries_[m] = Entry{std::move(bare), std::move(key), silent, never_heard};
+      }
+    }
     const auto age = in.heard_age.find(m);
     if (age != in.heard_age.end()) ages[std::to_string(m)] = num(age->second);
-    vessels.push_back(std::move(v));
   }
-  for (const auto& [m, key] : keys_) {
-    if (keys.count(m) == 0) removed.push_back(m);
+  for (auto it = entries_.begin(); it != entries_.end();) {
+    if (vessels.count(it->first) > 0) {
+      ++it;
+      continue;
+    }
+    removed.push_back(it->first);
+    it = entries_.erase(it);
   }
-  keys_.swap(keys);
   const std::uint64_t added = events.added();
   const std::size_t fresh =
       static_cast<std::size_t>(std::min<std::uint64_t>(added - events_framed_, events.size()));
   events_framed_ = added;
-  json full = board_fields(in, now, acks);
-  full["can_ack"] = can_ack;
-  json delta = full;
-  full["vessels"] = std::move(vessels);
-  full["events"] = events.to_json(now);
+  json delta = board_fields(in, now, acks);
+  delta["can_ack"] = can_ack;
   delta["delta"] = true;
   delta["vessels"] = std::move(changed);
   delta["removed"] = std::move(removed);
   delta["events"] = events.newest_json(fresh, now);
   delta["event_capacity"] = events.capacity();
   delta["heard_age"] = std::move(ages);
-  return BoardFrame{dump(full), dump(delta)};
+  return dump(delta);
+}
+
+std::string BoardFramer::full(const BoardInput& in, const EventHistory& events,
+                              const std::deque<AckOutcome>& acks, double now, bool can_ack) const {
+  json vessels = json::array();
+  for (const auto& [m, e] : entries_) vessels.push_back(with_ages(e.bare, in, now));
+  json board = board_fields(in, now, acks);
+  board["can_ack"] = can_ack;
+  board["vessels"] = std::move(vessels);
+  board["events"] = events.to_json(now);
+  return dump(board);
+}
+
+BoardFrame BoardFramer::frame(const BoardInput& in, const EventHistory& events,
+                              const std::deque<AckOutcome>& acks, double now, bool can_ack) {
+  BoardFrame f;
+  f.delta = delta(in, nullptr, events, acks, now, can_ack);
+  f.full = full(in, events, acks, now, can_ack);
+  return f;
 }
 
 bool acknowledged_by(const std::string& message, const std::string& operator_id) {

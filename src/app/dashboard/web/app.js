@@ -62,6 +62,10 @@ function detector(s) {
 const shownRows = new Map();    // mmsi -> { key, tr }: the board's rows as drawn
 const shownEvents = new Map();  // event key -> tr: the event list's rows as drawn
 let shownFilter = null;
+// The ages of rows not redrawn move on once a second, not on every push: at 1000 vessels a
+// push comes 5 times a second, and writing every row's ages each time (a relayout of the whole
+// table) held the next event's drawing up to 0.3 s.
+let agesDrawnAt = 0;
 
 function heardText(v) {
   return v.never_heard ? 'never heard' : (v.silent ? 'SILENT ' : '') + age(v.heard_age_s) + ' ago';
@@ -75,10 +79,16 @@ function shownEntry(v) {
   return JSON.stringify([v.mmsi, v.silent, v.never_heard, detector(v.status), sensors]);
 }
 
+function setText(node, text) {
+  if (node && node.textContent !== text) node.textContent = text;
+}
+
 function renderBoard() {
   const body = document.querySelector('#board tbody');
   const order = [];
   const seen = new Set();
+  const drawAges = Date.now() - agesDrawnAt >= 1000;
+  if (drawAges) agesDrawnAt = Date.now();
   for (const v of board.vessels) {
     seen.add(v.mmsi);
     // what the row shows besides its ages: the vessel, the buttons this page may show
@@ -96,13 +106,12 @@ function renderBoard() {
       if (row) row.tr.replaceWith(tr);
       row = { key, entry, tr };
       shownRows.set(v.mmsi, row);
-    } else {
+    } else if (drawAges) {
       // the same row: only its ages move on
-      row.tr.querySelector('td.heard').textContent = heardText(v);
+      setText(row.tr.querySelector('td.heard'), heardText(v));
       for (const s of SENSORS) {
         const r = v.sensors[s];
-        const d = row.tr.querySelector(`td[data-sensor="${s}"] .age`);
-        if (r && d) d.textContent = age(r.age_s) + ' ago';
+        if (r) setText(row.tr.querySelector(`td[data-sensor="${s}"] .age`), age(r.age_s) + ' ago');
       }
     }
     order.push(row.tr);
