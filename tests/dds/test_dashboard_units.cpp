@@ -96,6 +96,11 @@ nlohmann::json apply_delta(nlohmann::json board, const nlohmann::json& d) {
   for (const auto& v : board["vessels"]) vessels[v["mmsi"].get<std::uint32_t>()] = v;
   for (const auto& m : d["removed"]) vessels.erase(m.get<std::uint32_t>());
   for (const auto& v : d["vessels"]) vessels[v["mmsi"].get<std::uint32_t>()] = v;
+  if (d.contains("status_numbers")) {
+    for (const auto& [m, nums] : d["status_numbers"].items()) {
+      for (const auto& [k, x] : nums.items()) vessels[std::stoul(m)]["status"][k] = x;
+    }
+  }
   board["vessels"] = nlohmann::json::array();
   for (auto& [m, v] : vessels) {
     const std::string key = std::to_string(m);
@@ -216,10 +221,18 @@ TEST(DashboardBoard, ADeltaRebuildsOnlyTheVesselsThatChanged) {
   in.statuses[9].st.armed(true);
   in.statuses[9].written = 51.0;
   in.silent[3] = true;
-  const std::set<std::uint32_t> touched{7, 9};
+  // (and vessel 10's next status, which says nothing new: only its numbers move on)
+  in.statuses[10].written = 51.0;
+  in.statuses[10].st.samples(500);
+  const std::set<std::uint32_t> touched{7, 9, 10};
   const nlohmann::json d = nlohmann::json::parse(framer.delta(in, &touched, h, acks, 101.0, true));
-  // THEN only those three entries were built again, and the delta carries them
-  EXPECT_EQ(framer.rebuilt(), 3u);
+  // THEN only those four entries were built again, the delta carries three of them whole and
+  // vessel 10's status numbers apart
+  EXPECT_EQ(framer.rebuilt(), 4u);
+  ASSERT_TRUE(d["status_numbers"].contains("10")) << d["status_numbers"].dump();
+  EXPECT_EQ(d["status_numbers"].size(), 1u);
+  EXPECT_EQ(d["status_numbers"]["10"]["samples"], 500);
+  EXPECT_DOUBLE_EQ(d["status_numbers"]["10"]["written"].get<double>(), 51.0);
   std::vector<std::uint32_t> carried;
   for (const auto& v : d["vessels"]) carried.push_back(v["mmsi"].get<std::uint32_t>());
   EXPECT_EQ(carried, (std::vector<std::uint32_t>{3, 7, 9}));
@@ -232,7 +245,7 @@ TEST(DashboardBoard, ADeltaRebuildsOnlyTheVesselsThatChanged) {
   EXPECT_EQ(full, board_json_with_can_ack(in, h, acks, 101.0));
   // WHEN nothing is touched, THEN nothing is built again
   framer.delta(in, &touched, h, acks, 102.0, true);
-  EXPECT_EQ(framer.rebuilt(), 2u) << "the touched ones, found unchanged";
+  EXPECT_EQ(framer.rebuilt(), 3u) << "the touched ones, found unchanged";
   framer.delta(in, nullptr, h, acks, 102.0, true);
   EXPECT_EQ(framer.rebuilt(), 1000u);
   const std::set<std::uint32_t> none;

@@ -198,6 +198,31 @@ json with_ages(json v, const BoardInput& in, double now) {
   return v;
 }
 
+/// The fields of a vessel's status that move with every status it sends (once a second): a
+/// delta sends them apart from the entry, so that a status changes no entry unless it changes
+/// what the board says.
+constexpr const char* kStatusNumbers[] = {"stamp",       "a",       "excitation", "sigma_v",
+                                          "sigma_r",     "samples", "dropped",    "surge_speed",
+                                          "speed_ratio", "written"};
+
+/// An entry's key: the entry without its status numbers, dumped.
+std::string entry_key(json bare) {
+  json& st = bare["status"];
+  if (st.is_object()) {
+    for (const char* f : kStatusNumbers) st.erase(f);
+  }
+  return bare.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+json status_numbers(const json& status) {
+  json n = json::object();
+  for (const char* f : kStatusNumbers) {
+    const auto it = status.find(f);
+    if (it != status.end()) n[f] = *it;
+  }
+  return n;
+}
+
 bool is_silent(const BoardInput& in, std::uint32_t m) {
   const auto sil = in.silent.find(m);
   return sil != in.silent.end() && sil->second;
@@ -248,6 +273,7 @@ std::string BoardFramer::delta(const BoardInput& in, const std::set<std::uint32_
   const std::set<std::uint32_t> vessels = board_vessels(in);
   const std::set<std::uint32_t> never(in.roster_never_heard.begin(), in.roster_never_heard.end());
   json changed = json::array(), removed = json::array(), ages = json::object();
+  json numbers = json::object();
   rebuilt_ = 0;
   for (const std::uint32_t m : vessels) {
     const bool silent = is_silent(in, m), never_heard = never.count(m) > 0;
@@ -257,11 +283,15 @@ std::string BoardFramer::delta(const BoardInput& in, const std::set<std::uint32_
     if (stale) {
       ++rebuilt_;
       json bare = bare_entry(m, in, silent, never_heard);
-      std::string key = dump(bare);
-      // (what the entry says besides its ages, which move on with every board)
+      std::string key = entry_key(bare);
+      // (what the entry says besides its ages, which move on with every board, and its
+      // status's numbers, which move on with every status)
       if (it == entries_.end() || it->second.key != key) {
         changed.push_back(with_ages(bare, in, now));
         entries_[m] = Entry{std::move(bare), std::move(key), silent, never_heard};
+      } else if (bare["status"] != it->second.bare["status"]) {
+        numbers[std::to_string(m)] = status_numbers(bare["status"]);
+        it->second.bare["status"] = std::move(bare["status"]);
       }
     }
     const auto age = in.heard_age.find(m);
@@ -287,6 +317,7 @@ std::string BoardFramer::delta(const BoardInput& in, const std::set<std::uint32_
   delta["events"] = events.newest_json(fresh, now);
   delta["event_capacity"] = events.capacity();
   delta["heard_age"] = std::move(ages);
+  delta["status_numbers"] = std::move(numbers);
   return dump(delta);
 }
 

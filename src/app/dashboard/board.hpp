@@ -107,7 +107,10 @@ struct BoardFrame {
   /// entry changed other than in its ages (whole), the MMSIs gone ("removed"), the events added
   /// since (newest first; "event_capacity": how many the history keeps), every vessel's heard
   /// age ("heard_age", by MMSI), and now, silent_after, conflicts, acks and can_ack as in the
-  /// full board. A sensor's age_s is now - written.
+  /// full board; "status_numbers" (by MMSI): the numbers of the statuses that changed nothing
+  /// else of their vessel's entry (stamp, a, excitation, sigma_v, sigma_r, samples, dropped,
+  /// surge_speed, speed_ratio, written), to be set into that entry's status. A sensor's age_s
+  /// is now - written.
   std::string delta;
 };
 

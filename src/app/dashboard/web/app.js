@@ -299,6 +299,11 @@ function applyDelta(d) {
     vessels.set(v.mmsi, v);
     if (changed) changed.add(v.mmsi);
   }
+  // a status that changed none of the words of its vessel's entry: only its numbers
+  for (const [m, nums] of Object.entries(d.status_numbers || {})) {
+    const v = vessels.get(Number(m));
+    if (v && v.status) Object.assign(v.status, nums);
+  }
   for (const v of vessels.values()) {
     const heard = d.heard_age[v.mmsi];
     if (heard !== undefined) v.heard_age_s = heard;

@@ -128,8 +128,11 @@ function connect() {
       v = mine || null;  // the whole board, or this vessel's entry changed
     } else if (board.removed.includes(mmsi)) {
       v = null;
-    } else if (v && board.heard_age[mmsi] !== undefined) {
-      v.heard_age_s = board.heard_age[mmsi];  // a change elsewhere: only the age moves on
+    } else if (v) {
+      // a change elsewhere, or only this vessel's status numbers: the age and those move on
+      if (board.heard_age[mmsi] !== undefined) v.heard_age_s = board.heard_age[mmsi];
+      const nums = (board.status_numbers || {})[mmsi];
+      if (nums && v.status) Object.assign(v.status, nums);
     }
     document.getElementById('summary').textContent = v ? '' : 'not on the board';
     if (v) renderVessel(v);
