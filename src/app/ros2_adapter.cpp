@@ -60,17 +60,20 @@ void InsAssembler::add_rudder(double sent, double delta, bool valid) {
   const auto at = std::upper_bound(rudder_.begin(), rudder_.end(), sent,
                                    [](double t, const Rudder& x) { return t < x.sent; });
   rudder_.insert(at, r);
-  // Keep what a pending INS sample can still use: the last angle written before
-  // rudder_max_age ahead of the oldest one, and everything after it.
+  // Keep what an INS sample can still use, pending or yet to come (the Imu reader may lag the
+  // rudder reader): the last angle written rudder_max_age before the oldest pending one (none
+  // pending: the latest Imu sample added), and everything after it.
   const double newest = rudder_.back().sent;
   const double keep_from =
-      (pending_.empty() ? newest : std::min(newest, pending_.front().s.sent)) - p_.rudder_max_age;
+      std::min(newest, pending_.empty() ? last_yaw_sent_ : pending_.front().s.sent) -
+      p_.rudder_max_age;
   while (rudder_.size() > 2 && rudder_[1].sent < keep_from) rudder_.pop_front();
   while (rudder_.size() > 4096) rudder_.pop_front();
 }
 
 void InsAssembler::add_yaw(const YawSample& s, double wall_now) {
   pending_.push_back({s, wall_now});
+  if (std::isfinite(s.sent)) last_yaw_sent_ = std::max(last_yaw_sent_, s.sent);
 }
 
 std::vector<AssembledSample> InsAssembler::release(double wall_now) {

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -132,6 +133,8 @@ class InsAssembler {
   AssemblyParams p_;
   std::deque<std::pair<double, double>> sway_;  ///< (stamp, v), stamps increasing
   std::deque<Rudder> rudder_;                   ///< source timestamps increasing
+  /// The latest Imu sample's source timestamp (-inf: none yet) [s]
+  double last_yaw_sent_ = -std::numeric_limits<double>::infinity();
   std::deque<Pending> pending_;
   std::uint64_t sway_stale_ = 0, overflowed_ = 0, sway_rejected_ = 0, without_rudder_ = 0;
 };

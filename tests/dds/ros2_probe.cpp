@@ -263,6 +263,30 @@ int publish_paper(const Options& o) {
       write_at(twist_w, &x.odom, sent);
     }
   };
+  const auto write_burst = [&] {
+    if (burst.empty()) return;
+    if (o.burst == 1) {
+      write_at(rudder_w, &burst[0].rudder, 0.0);
+      write_at(imu_w, &burst[0].imu, 0.0);
+      write_sway(burst[0], 0.0);
+    } else {
+      // The instants' source times, 1/rate apart (wall time) up to now; each rudder angle
+      // 1 ms before its Imu sample.
+      const double wall_now =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+              .count();
+      const double step = 1.0 / (50.0 * o.speed);
+      for (std::size_t j = 0; j < burst.size(); ++j) {
+        burst[j].sent = wall_now - static_cast<double>(burst.size() - 1 - j) * step;
+      }
+      for (Instant& b : burst) {
+        write_at(imu_w, &b.imu, b.sent + 1e-3);
+        write_sway(b, b.sent + 1e-3);
+      }
+      for (Instant& b : burst) write_at(rudder_w, &b.rudder, b.sent);
+    }
+    burst.clear();
+  };
   while (!probe::g_stop.load() && sim.next(&row)) {
     const auto due = t0 + std::chrono::duration_cast<probe::Clock::duration>(
                               std::chrono::duration<double>(row.t / o.speed));
@@ -294,28 +318,9 @@ int publish_paper(const Options& o) {
     } else {
       std::this_thread::sleep_until(due);
     }
-    if (o.burst == 1) {
-      write_at(rudder_w, &burst[0].rudder, 0.0);
-      write_at(imu_w, &burst[0].imu, 0.0);
-      write_sway(burst[0], 0.0);
-    } else {
-      // The instants' source times, 1/rate apart (wall time) up to now; each rudder angle
-      // 1 ms before its Imu sample.
-      const double wall_now =
-          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-              .count();
-      const double step = 1.0 / (50.0 * o.speed);
-      for (std::size_t j = 0; j < burst.size(); ++j) {
-        burst[j].sent = wall_now - static_cast<double>(burst.size() - 1 - j) * step;
-      }
-      for (Instant& b : burst) {
-        write_at(imu_w, &b.imu, b.sent + 1e-3);
-        write_sway(b, b.sent + 1e-3);
-      }
-      for (Instant& b : burst) write_at(rudder_w, &b.rudder, b.sent);
-    }
-    burst.clear();
+    write_burst();
   }
+  write_burst();  // the last instants, fewer than --burst
   rudder_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(2.0));
   std::printf("published %llu\n", static_cast<unsigned long long>(n_pub));
   std::fflush(stdout);

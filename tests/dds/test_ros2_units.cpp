@@ -197,6 +197,31 @@ TEST(Ros2Assembly, AnImuSampleWaitsForTheRudderOnlyUpToThePairWait) {
   EXPECT_EQ(a.without_rudder(), 1u);
 }
 
+TEST(Ros2Assembly, AnglesAreKeptForImuSamplesThatArriveSecondsLater) {
+  // GIVEN an Imu reader that lags the rudder reader by 2 s (more than rudder_max_age): the
+  // angles of 0.5-3.0 s arrive while the last Imu sample added was the one of 0.4 s
+  AssemblyParams p;
+  p.rudder_max_age = 1.0;
+  InsAssembler a(p);
+  a.add_rudder(0.399, 0.0, true);
+  a.add_sway(0.4, 0.0);
+  a.add_yaw(yaw(0.4, 0.0), 0.0);
+  a.add_rudder(0.499, 0.05, true);
+  ASSERT_EQ(a.release(0.0).size(), 1u);  // none pending now
+  for (int k = 6; k <= 30; ++k) a.add_rudder(0.1 * k - 0.001, 0.01 * k, true);
+  // WHEN the Imu samples of 0.5 and 0.6 s come
+  for (const double t : {0.5, 0.6}) {
+    a.add_sway(t, 0.0);
+    a.add_yaw(yaw(t, 0.0), 0.0);
+  }
+  // THEN each gets its own angle (they were not pruned while no Imu sample was pending)
+  const auto out = a.release(0.0);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_DOUBLE_EQ(out[0].delta, 0.05);
+  EXPECT_DOUBLE_EQ(out[1].delta, 0.06);
+  EXPECT_EQ(a.without_rudder(), 0u);
+}
+
 TEST(Ros2Assembly, RudderAnglesOfTwoWritersAreOrderedByTheirSourceTime) {
   InsAssembler a(AssemblyParams{});
   a.add_rudder(0.10, 0.3, true);

@@ -87,7 +87,8 @@ function renderBoard() {
   const body = document.querySelector('#board tbody');
   const order = [];
   const seen = new Set();
-  const drawAges = Date.now() - agesDrawnAt >= 1000;
+  // (900 ms: a quiet fleet's pushes come once a second, and one at 999 ms must not skip a second)
+  const drawAges = Date.now() - agesDrawnAt >= 900;
   if (drawAges) agesDrawnAt = Date.now();
   for (const v of board.vessels) {
     seen.add(v.mmsi);
