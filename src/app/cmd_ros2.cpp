@@ -81,6 +81,7 @@ struct Input {
   double sent = 0.0;   ///< DDS source timestamp: when the writer wrote it (its clock) [s]
   double value = 0.0;
   bool valid = false;
+  double received = 0.0;  ///< DDS reception timestamp (this host's clock) [s]
 };
 
 /// The listener of the three ROS 2 readers: it only copies samples, in the order they arrive,
@@ -113,7 +114,8 @@ class InputQueue : public fdds::DataReaderListener {
         const double z = m.angular_velocity().z();
         // sensor_msgs/Imu: covariance element 0 = -1 means "no estimate of this field".
         const bool ok = std::isfinite(z) && m.angular_velocity_covariance()[0] != -1.0;
-        push({Input::kYaw, stamp_of(m.header()), sent_of(info), ros2::yaw_rate_from_rep103(z), ok});
+        push({Input::kYaw, stamp_of(m.header()), sent_of(info), ros2::yaw_rate_from_rep103(z), ok,
+              received_of(info)});
       }
     } else if (reader == sway && odometry_) {
       nav_msgs::msg::Odometry m;
@@ -138,7 +140,8 @@ class InputQueue : public fdds::DataReaderListener {
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
         const double d = m.data();
-        push({Input::kRudder, std::nan(""), sent_of(info), rudder_sign_ * d, std::isfinite(d)});
+        push({Input::kRudder, std::nan(""), sent_of(info), rudder_sign_ * d, std::isfinite(d),
+              received_of(info)});
       }
     }
   }
@@ -161,6 +164,10 @@ class InputQueue : public fdds::DataReaderListener {
   }
   static double sent_of(const fdds::SampleInfo& info) {
     return ros2::stamp_seconds(info.source_timestamp.seconds(), info.source_timestamp.nanosec());
+  }
+  static double received_of(const fdds::SampleInfo& info) {
+    return ros2::stamp_seconds(info.reception_timestamp.seconds(),
+                               info.reception_timestamp.nanosec());
   }
   void push(const Input& in) {
     {
@@ -375,6 +382,7 @@ class Adapter {
     const double now = mono_now();
     for (const Input& i : in) on_input(i, now);
     for (const ros2::AssembledSample& s : assembler_.release(mono_now())) publish(s);
+    check_clocks();
     view_.poll(0.0);
     diagnostics();
     mirrors();
@@ -385,10 +393,11 @@ class Adapter {
         "{} INS, {} rudder and {} speed samples published; {} Imu, {} sway, {} rudder messages "
         "read ({} dropped from the full input queue); {} INS samples with a stale sway "
         "velocity, {} without a rudder angle, {} sway samples refused (stamp repeated, backward "
-        "or not finite); {} DiagnosticArray messages",
+        "or not finite); the rudder writer's clock {:+.1f} ms from the Imu writer's; {} "
+        "DiagnosticArray messages",
         ins_seq_, rudder_seq_, speed_seq_, yaw_in_, sway_in_, rudder_in_, inputs_.dropped(),
         assembler_.sway_stale(), assembler_.without_rudder(), assembler_.sway_rejected(),
-        diag_sent_);
+        1e3 * skew_.skew(), diag_sent_);
   }
 
  private:
@@ -397,6 +406,7 @@ class Adapter {
       case Input::kRudder:
         ++rudder_in_;
         assembler_.add_rudder(i.sent, i.value, i.valid);
+        skew_.add(true, i.sent, i.received);
         break;
       case Input::kSway:
         ++sway_in_;
@@ -408,6 +418,7 @@ class Adapter {
       case Input::kYaw: {
         ++yaw_in_;
         ros2::YawSample y;
+        skew_.add(false, i.sent, i.received);
         y.stamp = i.stamp;
         y.sent = i.sent;
         y.r = i.valid ? i.value : 0.0;
@@ -418,6 +429,25 @@ class Adapter {
         assembler_.add_yaw(y, now);
         break;
       }
+    }
+  }
+
+  /// The rudder angles are paired on the writers' clocks: say so when the rudder writer's and
+  /// the Imu writer's disagree by more than a sample at 50 Hz (and when they agree again).
+  void check_clocks() {
+    const double skew = skew_.skew();
+    if (!std::isfinite(skew)) return;
+    if (!skew_warned_ && std::abs(skew) > 0.02) {
+      skew_warned_ = true;
+      spdlog::warn(
+          "the rudder writer's clock is {:+.0f} ms from the Imu writer's (DDS source timestamps "
+          "against this host's reception times): the rudder angles are paired with the Imu "
+          "samples on those clocks, so the pairing is off by that much; synchronise the hosts' "
+          "clocks (NTP, PTP)",
+          1e3 * skew);
+    } else if (skew_warned_ && std::abs(skew) < 0.01) {
+      skew_warned_ = false;
+      spdlog::info("the rudder and Imu writers' clocks agree again ({:+.1f} ms)", 1e3 * skew);
     }
   }
 
@@ -540,6 +570,8 @@ class Adapter {
   InputQueue& inputs_;
   RosSide& ros_;
   ros2::InsAssembler assembler_;
+  ros2::ClockSkew skew_;
+  bool skew_warned_ = false;
   fdds::DataWriter* ins_ = nullptr;
   fdds::DataWriter* rudder_ = nullptr;
   fdds::DataWriter* speed_ = nullptr;  ///< --surge-from-sway only

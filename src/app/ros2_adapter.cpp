@@ -139,6 +139,23 @@ void InsAssembler::pair_rudder(const YawSample& s, AssembledSample* a) {
   a->delta_valid = std::prev(after)->valid;
 }
 
+void ClockSkew::add(bool rudder, double sent, double received) {
+  const double d = received - sent;
+  if (!std::isfinite(d)) return;
+  Stream& s = rudder ? rudder_ : imu_;
+  s.current = std::min(s.current, d);
+  if (++s.n < block_) return;
+  s.last = s.current;
+  s.current = std::numeric_limits<double>::infinity();
+  s.n = 0;
+}
+
+double ClockSkew::skew() const {
+  // d = received - sent: a writer's clock behind the reader's makes d larger, so the rudder's
+  // clock less the Imu's is the Imu's least delay less the rudder's.
+  return imu_.last - rudder_.last;
+}
+
 const char* to_string(DiagLevel l) {
   switch (l) {
     case DiagLevel::kOk:

@@ -139,6 +139,29 @@ class InsAssembler {
   std::uint64_t sway_stale_ = 0, overflowed_ = 0, sway_rejected_ = 0, without_rudder_ = 0;
 };
 
+/// Whether the clocks of two writers agree, from what their samples say: each sample's
+/// reception time less its source time is the offset of its writer's clock from the reader's
+/// plus the transport delay, and its least value over a block of samples is that offset plus
+/// the least delay. The rudder angles are paired with the Imu samples on the writers' clocks,
+/// so a difference between the two writers' offsets shifts the pairing by that much.
+class ClockSkew {
+ public:
+  explicit ClockSkew(std::size_t block = 100) : block_(block) {}
+  void add(bool rudder, double sent, double received);
+  /// The rudder writer's clock less the Imu writer's [s]; NaN until each stream has filled a
+  /// block.
+  double skew() const;
+
+ private:
+  struct Stream {
+    double current = std::numeric_limits<double>::infinity();  ///< least delay of this block
+    double last = std::numeric_limits<double>::quiet_NaN();    ///< of the block before
+    std::size_t n = 0;
+  };
+  std::size_t block_;
+  Stream imu_, rudder_;
+};
+
 /// diagnostic_msgs/DiagnosticStatus levels.
 enum class DiagLevel : std::uint8_t { kOk = 0, kWarn = 1, kError = 2, kStale = 3 };
 const char* to_string(DiagLevel l);

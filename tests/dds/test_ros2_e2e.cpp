@@ -356,6 +356,10 @@ TEST(Ros2EndToEnd, RudderAnglesDeliveredAfterTheirImuSamplesArePairedWithTheirOw
       << text.substr(0, 2000) << f.log("ros2");
   f.process("ros2").signal(SIGTERM);
   ASSERT_TRUE(f.process("ros2").wait_exit(seconds(10)).has_value());
+  // AND the two writers' clocks (one host) were found to agree: no warning about them
+  const std::string log = f.log("ros2");
+  EXPECT_NE(log.find("ms from the Imu writer's"), std::string::npos) << log;
+  EXPECT_EQ(log.find("clock is"), std::string::npos) << log;
 }
 
 }  // namespace

@@ -222,6 +222,20 @@ TEST(Ros2Assembly, AnglesAreKeptForImuSamplesThatArriveSecondsLater) {
   EXPECT_EQ(a.without_rudder(), 0u);
 }
 
+TEST(Ros2Clocks, TheSkewOfTheRudderWritersClockIsItsLeastDelayAgainstTheImus) {
+  ClockSkew c(10);
+  EXPECT_TRUE(std::isnan(c.skew()));
+  // GIVEN an Imu writer on the reader's clock and a rudder writer whose clock is 50 ms ahead,
+  // both with transport delays of 1-5 ms
+  for (int k = 0; k < 10; ++k) {
+    const double t = 0.02 * k, delay = 0.001 + 0.004 * ((k * 7) % 10) / 10.0;
+    c.add(false, t, t + delay);
+    c.add(true, t + 0.050, t + delay);
+  }
+  // THEN the skew is 50 ms (the least delays of the block)
+  EXPECT_NEAR(c.skew(), 0.050, 1e-9);
+}
+
 TEST(Ros2Assembly, RudderAnglesOfTwoWritersAreOrderedByTheirSourceTime) {
   InsAssembler a(AssemblyParams{});
   a.add_rudder(0.10, 0.3, true);
