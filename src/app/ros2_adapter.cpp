@@ -53,13 +53,16 @@ void InsAssembler::add_sway(double stamp, double v) {
   while (sway_.size() > 4096) sway_.pop_front();
 }
 
+std::deque<InsAssembler::Rudder>::iterator InsAssembler::first_rudder_after(double sent) {
+  return std::upper_bound(rudder_.begin(), rudder_.end(), sent,
+                          [](double t, const Rudder& x) { return t < x.sent; });
+}
+
 void InsAssembler::add_rudder(double sent, double delta, bool valid) {
   if (!std::isfinite(sent)) return;
   const Rudder r{sent, valid ? delta : 0.0, valid && std::isfinite(delta)};
   // One writer's source timestamps increase; a second writer's may interleave with them.
-  const auto at = std::upper_bound(rudder_.begin(), rudder_.end(), sent,
-                                   [](double t, const Rudder& x) { return t < x.sent; });
-  rudder_.insert(at, r);
+  rudder_.insert(first_rudder_after(sent), r);
   // Keep what an INS sample can still use, pending or yet to come (the Imu reader may lag the
   // rudder reader): the last angle written rudder_max_age before the oldest pending one (none
   // pending: the latest Imu sample added), and everything after it.
@@ -128,8 +131,7 @@ AssembledSample InsAssembler::assemble(const YawSample& s) {
 void InsAssembler::pair_rudder(const YawSample& s, AssembledSample* a) {
   // The last angle written at or before the Imu sample (the same instant counts: a writer
   // that publishes the rudder first, as an autopilot's loop does, pairs exactly).
-  const auto after = std::upper_bound(rudder_.begin(), rudder_.end(), s.sent,
-                                      [](double t, const Rudder& x) { return t < x.sent; });
+  const auto after = first_rudder_after(s.sent);
   if (after == rudder_.begin() || !(s.sent - std::prev(after)->sent <= p_.rudder_max_age)) {
     ++without_rudder_;
     return;

@@ -129,6 +129,8 @@ class InsAssembler {
   };
   AssembledSample assemble(const YawSample& s);
   void pair_rudder(const YawSample& s, AssembledSample* a);
+  /// The first rudder angle written after `sent` (rudder_ is ordered by source time).
+  std::deque<Rudder>::iterator first_rudder_after(double sent);
 
   AssemblyParams p_;
   std::deque<std::pair<double, double>> sway_;  ///< (stamp, v), stamps increasing

@@ -18,6 +18,9 @@ using nlohmann::json;
 /// A number, or null when it is not finite (JSON has no NaN).
 json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
+/// Compact JSON text; invalid UTF-8 replaced, never thrown on.
+std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
 }  // namespace
 
 const char* presentation(FaultState s) {
@@ -211,7 +214,7 @@ std::string entry_key(json bare) {
   if (st.is_object()) {
     for (const char* f : kStatusNumbers) st.erase(f);
   }
-  return bare.dump(-1, ' ', false, json::error_handler_t::replace);
+  return dump(bare);
 }
 
 json status_numbers(const json& status) {
@@ -241,8 +244,6 @@ json ack_list_json(const std::deque<AckOutcome>& acks) {
   }
   return out;
 }
-
-std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
 /// What every board and every delta carries beside its vessels and events.
 json board_fields(const BoardInput& in, double now, const std::deque<AckOutcome>& acks) {
