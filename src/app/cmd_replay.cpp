@@ -30,6 +30,7 @@ struct ReplayArgs {
   std::string output;               ///< empty or "-": stdout
   std::string format = "auto";      ///< auto (by the extension), csv or nmea
   std::optional<double> nmea_rate;  ///< NMEA: sentence cycle and sample rate [Hz]
+  std::string nmea_hold = "due";    ///< NMEA: due (until the next is due) or max-age
   io::ReplayOptions options;
 };
 
@@ -144,6 +145,7 @@ int run_replay(const ReplayArgs& a) {
         o.cycle_rate_hz = a.nmea_rate;
       }
       o.max_age_s = std::max(1.0, 2.5 / o.grid_rate_hz);
+      o.hold_until_due = a.nmea_hold == "due";
       log = std::make_unique<io::NmeaSampleReader>(a.input, o);
     } else {
       csv = std::make_unique<io::CsvSampleReader>(a.input);
@@ -227,6 +229,12 @@ void register_replay_command(CommandRegistry& registry) {
                   "that times a log without TAG block times (c:): one cycle per repeated "
                   "sentence")
       ->check(CLI::PositiveNumber);
+  sub->add_option("--nmea-hold", args->nmea_hold,
+                  "NMEA: how long a value is held on the sample grid: due (until its sentence's "
+                  "next is due, the period learned from the log; a lost sentence is a gap) or "
+                  "max-age (up to the max age, zero-order hold)")
+      ->check(CLI::IsMember({"due", "max-age"}))
+      ->capture_default_str();
   sub->add_option("--output", args->output, "output JSON Lines file (default: stdout)");
   sub->add_option("--estimate-period", args->options.estimate_period,
                   "data time between estimate records [s]")

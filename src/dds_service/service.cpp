@@ -461,8 +461,9 @@ void FdiService::start() {
     nmea_->start();
     if (log_) {
       char rate[96];
-      std::snprintf(rate, sizeof rate, "samples at %g Hz, max age %g s",
-                    cfg_.nmea.assembler.rate_hz, cfg_.nmea.assembler.max_age_s);
+      std::snprintf(rate, sizeof rate, "samples at %g Hz, max age %g s%s",
+                    cfg_.nmea.assembler.rate_hz, cfg_.nmea.assembler.max_age_s,
+                    cfg_.nmea.assembler.hold_until_due ? ", held until the next is due" : "");
       log_(1, "NMEA input: " + nmea_->describe() + " (receive buffer " +
                   std::to_string(nmea_->receive_buffer()) + " bytes), " + rate);
     }

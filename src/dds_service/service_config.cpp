@@ -270,6 +270,9 @@ void add_input_keys(ServiceLoad* s, ConfigValue::Table* table) {
       n.assembler.rate_hz = a.number(1e-3, 1e4, "a rate in Hz", "0.001 to 10000 Hz");
     };
     keys["max_age"] = positive_time(&n.assembler.max_age_s);
+    keys["hold_until_due"] = [&n](const ConfigValue& a) {
+      n.assembler.hold_until_due = a.boolean();
+    };
     keys["receive_buffer"] = [&n](const ConfigValue& a) {
       n.receive_buffer =
           static_cast<int>(a.integer(0, 1 << 30, "a size in bytes", "0..1073741824 bytes"));

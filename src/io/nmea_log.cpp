@@ -87,6 +87,7 @@ NmeaSampleReader::NmeaSampleReader(std::unique_ptr<std::istream> in, const std::
   nmea::AssemblerConfig ac;
   ac.rate_hz = options.grid_rate_hz;
   ac.max_age_s = options.max_age_s;
+  ac.hold_until_due = options.hold_until_due;
   ac.rudder_sign = nmea::rudder_sign_from_b2(options.b2);
   assembler_ = std::make_unique<nmea::SampleAssembler>(ac);  // refuses a bad rate or age
 }

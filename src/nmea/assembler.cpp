@@ -1,6 +1,7 @@
 // SampleAssembler (include/usv_fdi/nmea/assembler.hpp).
 #include "usv_fdi/nmea/assembler.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <stdexcept>
@@ -9,6 +10,56 @@ namespace usvfdi::nmea {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMinTolerance = 0.002;  ///< [s]: jitter below this is not told apart
+constexpr double kMadsOfJitter = 4.5;    ///< ~3 standard deviations of Gaussian jitter
+constexpr double kMaxScatter = 0.25;     ///< MAD / period beyond which a sentence is irregular
+
+double median_of(double* x, int n) {
+  std::nth_element(x, x + n / 2, x + n);
+  const double hi = x[n / 2];
+  if (n % 2 == 1) return hi;
+  return 0.5 * (hi + *std::max_element(x, x + n / 2));
+}
+}  // namespace
+
+void SampleAssembler::Arrivals::arrive(double t) {
+  const double dt = t - last;
+  last = t;
+  if (!(dt > 0.0)) return;  // the first arrival, or another line of the same datagram
+  intervals[next] = dt;
+  next = (next + 1) % kKeptIntervals;
+  count = std::min(count + 1, kKeptIntervals);
+  period = kNaN;
+  if (count < kMinIntervals) return;
+  double x[kKeptIntervals];
+  std::copy(intervals, intervals + count, x);
+  const double p = median_of(x, count);
+  for (int i = 0; i < count; ++i) x[i] = std::abs(x[i] - p);
+  const double mad = median_of(x, count);
+  if (mad > kMaxScatter * p) return;  // not periodic: held up to max_age_s
+  period = p;
+  tolerance = std::max(kMadsOfJitter * mad, kMinTolerance);
+}
+
+SampleAssembler::Feed SampleAssembler::feed_of(Slot slot) {
+  switch (slot) {
+    case kR:
+      return kRot;
+    case kDelta:
+      return kRsa;
+    case kUGround:
+      return kVtg;
+    default:
+      return kVbw;  // v and the water speed
+  }
+}
+
+double SampleAssembler::learned_period(const std::string& sentence) const {
+  if (sentence == "ROT") return arrivals_[kRot].period;
+  if (sentence == "RSA") return arrivals_[kRsa].period;
+  if (sentence == "VBW") return arrivals_[kVbw].period;
+  if (sentence == "VTG") return arrivals_[kVtg].period;
+  return kNaN;
 }
 
 SampleAssembler::SampleAssembler(const AssemblerConfig& config) : config_(config) {
@@ -42,6 +93,7 @@ void SampleAssembler::set(Slot slot, double t, bool valid, double value) {
   if (valid && std::isfinite(value)) {
     held_[slot].value = value;
     held_[slot].time = t;
+    held_[slot].used = false;
   } else {
     held_[slot].value = kNaN;  // invalid from now on; the age keeps counting
   }
@@ -49,12 +101,14 @@ void SampleAssembler::set(Slot slot, double t, bool valid, double value) {
 
 bool SampleAssembler::add(double t, const Rot& rot) {
   if (!accept_time(t)) return false;
+  arrivals_[kRot].arrive(t);
   set(kR, t, rot.valid(), rot.valid() ? yaw_rate_from_rot(*rot.rate_deg_per_min) : kNaN);
   return true;
 }
 
 bool SampleAssembler::add(double t, const Rsa& rsa) {
   if (!accept_time(t)) return false;
+  arrivals_[kRsa].arrive(t);
   if (rsa.starboard_valid()) {
     set(kDelta, t, true, delta_from_rsa(*rsa.starboard_deg, config_.rudder_sign));
   } else if (rsa.port_valid()) {
@@ -67,6 +121,7 @@ bool SampleAssembler::add(double t, const Rsa& rsa) {
 
 bool SampleAssembler::add(double t, const Vbw& vbw) {
   if (!accept_time(t)) return false;
+  arrivals_[kVbw].arrive(t);
   const bool water = vbw.water_valid();
   set(kV, t, water && vbw.water_transverse_kn,
       water && vbw.water_transverse_kn ? speed_from_knots(*vbw.water_transverse_kn) : kNaN);
@@ -77,6 +132,7 @@ bool SampleAssembler::add(double t, const Vbw& vbw) {
 
 bool SampleAssembler::add(double t, const Vtg& vtg) {
   if (!accept_time(t)) return false;
+  arrivals_[kVtg].arrive(t);
   const bool ok = vtg.valid() && vtg.speed_kn;
   set(kUGround, t, ok, ok ? speed_from_knots(*vtg.speed_kn) : kNaN);
   return true;
@@ -121,10 +177,17 @@ void SampleAssembler::advance(double t) {
   emit_before(t, true);
 }
 
-double SampleAssembler::at(Slot slot, double g, double* age) const {
-  const Held& h = held_[slot];
+double SampleAssembler::at(Slot slot, double g, double* age) {
+  Held& h = held_[slot];
   *age = kNaN;
   if (std::isnan(h.value) || !(g - h.time <= config_.max_age_s)) return kNaN;
+  const Arrivals& a = arrivals_[feed_of(slot)];
+  if (config_.hold_until_due && !std::isnan(a.period)) {
+    const double due = h.time + a.period;
+    if (g >= due + a.tolerance) return kNaN;            // the successor is overdue
+    if (h.used && g >= due - a.tolerance) return kNaN;  // due now: not the old value again
+  }
+  h.used = true;
   *age = g - h.time;
   return h.value;
 }

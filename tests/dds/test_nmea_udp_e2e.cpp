@@ -41,14 +41,16 @@ unsigned test_port(unsigned index) {
 /// lost datagram is a gap in the samples, not the previous value held for one more sample
 /// (held, on the noise-free paper scenario, it delays identification, the gyro bias on 20-40 s
 /// goes unseen and a gyro "noise" fault is raised at 40.7 s; docs/integration.md).
-std::vector<std::string> nmea_service(unsigned port, const std::vector<std::string>& extra = {}) {
+/// max_age: the nmea.max_age line's value ("" : none, the default 1 s).
+std::vector<std::string> nmea_service(unsigned port, const std::vector<std::string>& extra = {},
+                                      const std::string& max_age = "0.05") {
   std::vector<std::string> lines = {"input: nmea",
                                     "nmea:",
                                     std::string("  address: ") + kGroup,
                                     "  port: " + std::to_string(port),
                                     "  interface: 127.0.0.1",
-                                    "  rate: 10",
-                                    "  max_age: 0.05"};
+                                    "  rate: 10"};
+  if (!max_age.empty()) lines.push_back("  max_age: " + max_age);
   lines.insert(lines.end(), extra.begin(), extra.end());
   return lines;
 }
@@ -269,7 +271,8 @@ TEST(NmeaUdpEndToEnd, LostDatagramsAreCountedAndInventNoFault) {
     }
   }
   ASSERT_EQ(lines.size(), 3u * 1001u);
-  const std::string cfg = f.write_service_config("svc", m, nmea_service(port));
+  // (the default nmea.max_age, 1 s: a value is held until its next sentence is due)
+  const std::string cfg = f.write_service_config("svc", m, nmea_service(port, {}, ""));
   ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
   f.start_service("svc", cfg, 1);
   ASSERT_TRUE(f.wait_for_log("svc", "NMEA input: multicast group", seconds(10))) << f.log("svc");

@@ -128,6 +128,46 @@ TEST_F(NmeaReplay, PaperScenarioThroughNmeaRaisesAndIsolatesBothFaultsLikeTheCsv
   EXPECT_EQ(sum.at("rejected").num, 0.0);
 }
 
+TEST_F(NmeaReplay, LostSentencesAreGapsNotTheOldValuesAgain) {
+  // GIVEN the noise-free paper scenario as NMEA, with every 37th sample's three lines (ROT,
+  // RSA, VBW: one datagram) lost
+  const std::string log =
+      sim("--vessel otter --scenario paper --rate 10 --noise-scale 0 --seed 1 --nmea", "p.nmea");
+  std::istringstream in(log);
+  std::string lossy;
+  int k = 0;
+  for (std::string line; std::getline(in, line); ++k) {
+    if (k / 3 % 37 != 36) lossy += line + "\n";
+  }
+  {
+    std::ofstream out(path("lossy.nmea"));
+    out << lossy;
+  }
+  // WHEN it is replayed with each way of holding a value on the grid
+  const auto due = replay("config/scenarios/paper.yaml", path("lossy.nmea"));
+  const auto held =
+      replay("config/scenarios/paper.yaml", path("lossy.nmea"), "--nmea-hold max-age");
+  // THEN held until due (the default), the lost samples are gaps: the gyro fault, then the
+  // accelerometer fault, at their onsets, nothing else
+  const auto d = raised(due);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].sensor, "gyro");
+  EXPECT_NEAR(d[0].detection_time, 20.0, 1.0);
+  EXPECT_EQ(d[1].sensor, "accelerometer");
+  EXPECT_NEAR(d[1].detection_time, 60.0, 1.0);
+  EXPECT_EQ(due.back().at("samples").num, 1001.0 - 27.0);  // 27 grid times without a sample
+  // AND held up to the max age (the zero-order hold), the old values again at those grid
+  // times: every sample is there, and the voyage's faults are not what it raises
+  const auto h = raised(held);
+  EXPECT_EQ(held.back().at("samples").num, 1001.0);
+  EXPECT_FALSE(h.size() == 2u && h[0].sensor == "gyro" && h[0].detection_time < 21.0 &&
+               h[1].sensor == "accelerometer")
+      << "the zero-order hold no longer disturbs the engine: the comparison shows nothing";
+  // AND a hold that is neither is refused
+  replay("config/scenarios/paper.yaml", path("lossy.nmea"), "--nmea-hold sometimes", 64);
+  EXPECT_TRUE(has(last_err_, "--nmea-hold")) << last_err_;
+}
+
 TEST_F(NmeaReplay, HealthyVoyageThroughNmeaRaisesNothing) {
   EXPECT_TRUE(has(sim("--vessel otter --scenario healthy --rate 10 --duration 150 --seed 1 "
                       "--nmea --nmea-heading",

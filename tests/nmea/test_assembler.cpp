@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "support.hpp"
 #include "usv_fdi/nmea/assembler.hpp"
@@ -107,27 +108,148 @@ TEST(Assembler, SampleUsesOnlyInputsAtOrBeforeItsTime) {
 TEST(Assembler, OldValuesGoMissingAndTheSentenceIsReportedStale) {
   AssemblerConfig c;
   c.max_age_s = 0.5;
+  for (const bool until_due : {false, true}) {
+    c.hold_until_due = until_due;
+    SampleAssembler a(c);
+    for (int i = 0; i <= 30; ++i) {
+      if (i <= 10) a.add(0.1 * i, rot(1.0));  // ROT until t = 1.0
+      a.add(0.1 * i, rsa(2.0));               // RSA until t = 3.0
+    }
+    EXPECT_EQ(a.out_of_order(), 0u);
+    a.advance(3.0);
+    // Held up to max_age_s; held until due: missing once the next ROT (1.1) is due.
+    const double last_held = until_due ? 1.0 : 1.5;
+    for (const auto& x : a.take()) {
+      EXPECT_EQ(std::isnan(x.r), x.t > last_held + 1e-9) << x.t << " until_due " << until_due;
+      EXPECT_FALSE(std::isnan(x.delta)) << x.t;
+    }
+    // Stale (the sentence has stopped) only after max_age_s either way.
+    const auto st = a.stale(3.0);
+    ASSERT_EQ(st.size(), 3u);  // r stopped; v and u never received
+    EXPECT_EQ(st[0].quantity, "v");
+    EXPECT_TRUE(st[0].never_received);
+    EXPECT_EQ(st[1].quantity, "r");
+    EXPECT_EQ(st[1].sentence, "ROT");
+    EXPECT_FALSE(st[1].never_received);
+    EXPECT_NEAR(st[1].age_s, 2.0, 1e-9);
+    EXPECT_EQ(st[2].sentence, "VBW/VTG");
+    EXPECT_TRUE(a.stale(1.4).size() == 2u);  // ROT not yet stale at 1.4
+  }
+}
+
+// The sentences of a grid-rate INS (TAG times on the grid, as the simulator sends them): a lost
+// ROT is a gap in r at its grid time, not the previous value again; the zero-order hold (the
+// old behaviour, hold_until_due false) repeats it.
+TEST(Assembler, ALostSentenceIsAGapNotTheOldValueAgain) {
+  for (const bool until_due : {false, true}) {
+    AssemblerConfig c;
+    c.hold_until_due = until_due;
+    SampleAssembler a(c);
+    for (int i = 0; i <= 40; ++i) {
+      if (i != 25 && i != 31 && i != 32) a.add(0.1 * i, rot(i));  // lost: 2.5, 3.1, 3.2
+      a.add(0.1 * i, rsa(i));
+    }
+    a.advance(4.0);
+    const auto s = a.take();
+    ASSERT_EQ(s.size(), 41u);
+    for (int i = 0; i <= 40; ++i) {
+      const bool lost = i == 25 || i == 31 || i == 32;
+      EXPECT_NEAR(s[i].delta, delta_from_rsa(i, RudderSign::kPositiveToPort), 1e-15);
+      if (!lost) {
+        EXPECT_NEAR(s[i].r, yaw_rate_from_rot(i), 1e-15) << i;
+        EXPECT_NEAR(s[i].age_r, 0.0, 1e-12);
+      } else if (until_due) {
+        EXPECT_TRUE(std::isnan(s[i].r)) << i;
+        EXPECT_TRUE(std::isnan(s[i].age_r)) << i;
+      } else {
+        EXPECT_NEAR(s[i].r, yaw_rate_from_rot(i == 32 ? 30 : i - 1), 1e-15) << i;
+      }
+    }
+    if (until_due) {
+      EXPECT_NEAR(a.learned_period("ROT"), 0.1, 1e-12);
+    }
+  }
+}
+
+// Sentences whose times straddle the grid (the receive clock, a sender's jitter): each sample
+// has the latest ROT measured at or before its time, except where that ROT is already in the
+// previous sample while the next was due: a gap there, never the same value twice.
+TEST(Assembler, JitterAroundTheGridNeverRepeatsAValue) {
+  SampleAssembler a(AssemblerConfig{});
+  std::vector<double> times;
+  for (int i = 0; i < 200; ++i) {
+    times.push_back(0.1 * i + 0.0015 * std::sin(1.7 * i));  // +-1.5 ms around the grid
+    // RSA on the grid (every grid time has a sample); the inputs in time order
+    const bool rot_first = times.back() <= 0.1 * i;
+    if (!rot_first) {
+      ASSERT_TRUE(a.add(0.1 * i, rsa(1.0)));
+    }
+    ASSERT_TRUE(a.add(times.back(), rot(i)));
+    if (rot_first) {
+      ASSERT_TRUE(a.add(0.1 * i, rsa(1.0)));
+    }
+  }
+  a.advance(0.1 * 199);
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 200u);
+  const auto latest_at = [&](double t) {
+    int latest = -1;
+    for (int i = 0; i < 200; ++i) {
+      if (times[i] <= t) latest = i;
+    }
+    return latest;
+  };
+  // Before the period is known, the zero-order hold: every sample has the latest value.
+  const int k0 = SampleAssembler::kMinIntervals + 2;
+  ASSERT_FALSE(std::isnan(s[k0 - 1].r));
+  int used = latest_at(s[k0 - 1].t);
+  int gaps = 0;
+  for (int k = k0; k < 200; ++k) {
+    const int latest = latest_at(s[k].t);
+    if (latest == used) {
+      ++gaps;
+      EXPECT_TRUE(std::isnan(s[k].r)) << s[k].t;
+    } else {
+      EXPECT_NEAR(s[k].r, yaw_rate_from_rot(latest), 1e-15) << s[k].t;
+      used = latest;
+    }
+  }
+  EXPECT_GT(gaps, 20);  // the pattern has them (a ROT after the grid time that follows one before)
+}
+
+// A sentence slower than the grid (VBW at 1 Hz on a 10 Hz grid) is held over the grid times
+// between its arrivals, up to the next one's due time; a lost VBW leaves v missing until the
+// next one comes.
+TEST(Assembler, ASlowSentenceIsHeldUntilItsNextIsDue) {
+  AssemblerConfig c;
+  c.max_age_s = 3.0;
   SampleAssembler a(c);
-  for (int i = 0; i <= 30; ++i) {
-    if (i <= 10) a.add(0.1 * i, rot(1.0));  // ROT until t = 1.0
-    a.add(0.1 * i, rsa(2.0));               // RSA until t = 3.0
+  for (int i = 0; i <= 100; ++i) {
+    const double t = 0.1 * i;
+    a.add(t, rot(1.0));
+    if (i % 10 == 3 && i != 63) a.add(t, vbw(5.0, 0.1 * i));  // 1 Hz at x.3 s; 6.3 lost
   }
-  EXPECT_EQ(a.out_of_order(), 0u);
-  a.advance(3.0);
+  a.advance(10.0);
+  EXPECT_NEAR(a.learned_period("VBW"), 1.0, 1e-9);
   for (const auto& x : a.take()) {
-    EXPECT_EQ(std::isnan(x.r), x.t > 1.5 + 1e-9) << x.t;
-    EXPECT_FALSE(std::isnan(x.delta)) << x.t;
+    if (x.t < 0.3 - 1e-9) continue;
+    const bool lost = x.t > 6.3 - 1e-9 && x.t < 7.3 - 1e-9;
+    EXPECT_EQ(std::isnan(x.v), lost) << x.t;
+    if (!lost) {
+      EXPECT_LT(x.age_v, 1.0 - 1e-9) << x.t;
+    }
   }
-  const auto st = a.stale(3.0);
-  ASSERT_EQ(st.size(), 3u);  // r stopped; v and u never received
-  EXPECT_EQ(st[0].quantity, "v");
-  EXPECT_TRUE(st[0].never_received);
-  EXPECT_EQ(st[1].quantity, "r");
-  EXPECT_EQ(st[1].sentence, "ROT");
-  EXPECT_FALSE(st[1].never_received);
-  EXPECT_NEAR(st[1].age_s, 2.0, 1e-9);
-  EXPECT_EQ(st[2].sentence, "VBW/VTG");
-  EXPECT_TRUE(a.stale(1.4).size() == 2u);  // ROT not yet stale at 1.4
+}
+
+// A sentence whose intervals scatter (an irregular sender) has no period: it is held up to
+// max_age_s as before.
+TEST(Assembler, AnIrregularSentenceIsHeldUpToMaxAge) {
+  SampleAssembler a(AssemblerConfig{});
+  const double times[] = {0.0, 0.05, 0.4, 0.45, 0.9, 1.3, 1.32, 1.8, 2.0, 2.6, 2.65, 3.0};
+  for (double t : times) a.add(t, rot(t * 10));
+  a.advance(3.0);
+  EXPECT_TRUE(std::isnan(a.learned_period("ROT")));
+  for (const auto& x : a.take()) EXPECT_FALSE(std::isnan(x.r)) << x.t;
 }
 
 TEST(Assembler, StatusVInvalidatesWithoutRefreshingTheAge) {

@@ -198,6 +198,7 @@ service:
     interface: 127.0.0.1
     rate: 20
     max_age: 0.5
+    hold_until_due: false
     receive_buffer: 65536
 )");
   // THEN each is applied, and the rudder sign follows model.B (b2 > 0: RSA's sign)
@@ -208,6 +209,8 @@ service:
   EXPECT_EQ(c.nmea.interface_address, "127.0.0.1");
   EXPECT_DOUBLE_EQ(c.nmea.assembler.rate_hz, 20.0);
   EXPECT_DOUBLE_EQ(c.nmea.assembler.max_age_s, 0.5);
+  EXPECT_FALSE(c.nmea.assembler.hold_until_due);
+  EXPECT_TRUE(d.nmea.assembler.hold_until_due);
   EXPECT_EQ(c.nmea.receive_buffer, 65536);
   EXPECT_EQ(c.nmea.assembler.rudder_sign, nmea::RudderSign::kPositiveToStarboard);
   EXPECT_EQ(d.nmea.assembler.rudder_sign, nmea::RudderSign::kPositiveToPort);  // b2 < 0
@@ -218,6 +221,7 @@ service:
       {"  nmea:\n    address: vessel", "5: service.nmea.address = vessel: "},
       {"  nmea:\n    port: 70000", "5: service.nmea.port = 70000: must be a UDP port"},
       {"  nmea:\n    rate: 0", "5: service.nmea.rate = 0: must be 0.001 to 10000 Hz"},
+      {"  nmea:\n    hold_until_due: sometimes", "5: service.nmea.hold_until_due = sometimes: "},
       {"  nmea:\n    group: 239.192.0.1", "5: service.nmea.group = group: unknown key"},
   };
   for (const auto& [service, expect] : cases) {

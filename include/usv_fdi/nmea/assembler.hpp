@@ -12,14 +12,27 @@
 //   VTG  -> u     [m/s]    = speed over ground, when no valid VBW water speed is fresh (a mode
 //                            indicator N, E, M or S makes it invalid)
 // A value whose status is V (or whose field is empty) invalidates the quantity from then on
-// without refreshing its age. Each quantity holds its latest valid value (zero-order hold).
+// without refreshing its age. Each quantity holds its latest valid value (zero-order hold)
+// until the next sentence of its kind is due (below), never longer than max_age_s.
 //
 // Output: a sample at every grid time g = k / rate_hz (k integer, so several assemblers share
 // the same grid), holding each quantity's latest valid value measured at or before g, and
-// NaN where that value is older than max_age_s, or none was received (NaN is how
-// usvfdi::Sample marks a missing value; u NaN = not measured). A grid time where every
-// quantity is missing is not emitted (no flood of empty samples after a long silence).
-// Samples are emitted when an input later than g arrives, or by advance(t) for g <= t.
+// NaN where that value is older than max_age_s, or none was received, or (hold_until_due) its
+// successor is overdue (NaN is how usvfdi::Sample marks a missing value; u NaN = not
+// measured). A grid time where every quantity is missing is not emitted (no flood of empty
+// samples after a long silence). Samples are emitted when an input later than g arrives, or
+// by advance(t) for g <= t.
+//
+// Held until due (hold_until_due, the default): each sentence's period P is learned as the
+// median of its last intervals (at least kMinIntervals, positive ones only: lines of one
+// datagram share a time), with a tolerance tol = max(4.5 MAD, 2 ms) for the jitter; a
+// sentence whose intervals scatter by more than P / 4 (MAD) is not periodic and is held up
+// to max_age_s. A value measured at tau is then missing at g when its successor is overdue,
+// g >= tau + P + tol, or when it is due about now, g >= tau + P - tol, and the value was
+// already in an earlier sample: a lost sentence is a gap in that quantity, not the previous
+// value again (a repeated value is a step of the signal's derivative, which the observers
+// read as a fault). Sentences slower than the grid (VBW at 1 Hz on a 10 Hz grid) are held
+// over the grid times between them as before.
 //
 // stale(t) names the sentences that have stopped: a quantity without a valid value for more
 // than max_age_s (or never received, max_age_s after the first input), with its age. (A
@@ -39,6 +52,9 @@ namespace usvfdi::nmea {
 struct AssemblerConfig {
   double rate_hz = 10.0;   ///< output rate (> 0)
   double max_age_s = 1.0;  ///< a value older than this is missing in the sample (> 0)
+  /// A value is missing once its sentence's successor is due and has not come (the period
+  /// learned from the sentence's arrivals); false: held up to max_age_s (zero-order hold).
+  bool hold_until_due = true;
   RudderSign rudder_sign = RudderSign::kPositiveToPort;  ///< the vessel model's (b2 < 0)
 };
 
@@ -113,23 +129,45 @@ class SampleAssembler {
 
   std::size_t out_of_order() const { return out_of_order_; }
 
+  /// The learned period of a sentence ("ROT", "RSA", "VBW", "VTG") [s]; NaN while unknown
+  /// (fewer than kMinIntervals intervals) or not periodic.
+  double learned_period(const std::string& sentence) const;
+
+  static constexpr int kMinIntervals = 4;    ///< before this, a value is held up to max_age_s
+  static constexpr int kKeptIntervals = 15;  ///< the intervals the period is the median of
+
  private:
+  /// The arrivals of one sentence formatter: the period and jitter it is learned from.
+  struct Arrivals {
+    double last = std::numeric_limits<double>::quiet_NaN();
+    double intervals[kKeptIntervals] = {};
+    int count = 0;  ///< intervals kept (up to kKeptIntervals)
+    int next = 0;   ///< where the next interval goes
+    double period = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not learned
+    double tolerance = 0.0;
+    void arrive(double t);
+  };
+  enum Feed { kRot = 0, kRsa, kVbw, kVtg, kFeeds };
   struct Held {
     double value = std::numeric_limits<double>::quiet_NaN();  ///< NaN: invalidated
     double time = std::numeric_limits<double>::quiet_NaN();   ///< of the last valid value
+    bool used = false;                                        ///< the value is in an emitted sample
   };
   enum Slot { kV = 0, kR, kDelta, kUWater, kUGround, kSlots };
+  static Feed feed_of(Slot slot);
 
   bool accept_time(double t);
   void emit_before(double t, bool inclusive);
   long long first_grid_index(double t, bool after) const;
   void set(Slot slot, double t, bool valid, double value);
-  /// The held value of `slot` at grid time g, or NaN (missing / too old); *age its age.
-  double at(Slot slot, double g, double* age) const;
+  /// The held value of `slot` at grid time g, or NaN (missing / too old / overdue); *age its
+  /// age. A value returned is marked used.
+  double at(Slot slot, double g, double* age);
 
   AssemblerConfig config_;
   double period_;
   Held held_[kSlots];
+  Arrivals arrivals_[kFeeds];
   double first_input_ = std::numeric_limits<double>::quiet_NaN();
   double latest_input_ = -std::numeric_limits<double>::infinity();
   long long next_k_ = 0;  ///< the next grid index to emit
