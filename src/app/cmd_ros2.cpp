@@ -557,8 +557,10 @@ class Adapter {
     });
     if (const auto* vessels = view_.vessels()) {
       const VesselStatus* v = vessels->shown(a_.mmsi);
-      if (v != nullptr && v->st.stamp() != last_status_stamp_) {
-        last_status_stamp_ = v->st.stamp();
+      // Each status sample once, by its source time (its stamp is NaN until the first INS
+      // sample, and NaN != NaN would mirror that status again on every pass).
+      if (v != nullptr && v->written != last_status_written_) {
+        last_status_written_ = v->written;
         auto m = mirror_of(v->st);
         ros_.status->write(&m);
       }
@@ -582,7 +584,7 @@ class Adapter {
   std::map<std::string, ros2::DiagLevel> last_levels_;
   Clock::time_point next_diag_ = Clock::now();
   std::map<int, std::tuple<std::uint64_t, std::uint64_t, FaultState>> mirrored_;
-  double last_status_stamp_ = std::nan("");
+  double last_status_written_ = -1.0;  ///< source time of the last status mirrored
 };
 
 int run_ros2(Ros2Args& a) {

@@ -260,7 +260,7 @@ DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row
     const FaultEvent& e = row->ev;
     d.values = {{"C_a", fmt::format("{:.3f}", e.c_a)},
                 {"C_g", fmt::format("{:.3f}", e.c_g)},
-                {"statistic", fmt::format("{:.6g}", e.statistic)},
+                {"J_N", fmt::format("{:.6g}", e.statistic)},
                 {"threshold", fmt::format("{:.6g}", e.threshold)},
                 {"state", to_string(e.state)},
                 {"sequence", std::to_string(e.sequence)},

@@ -27,7 +27,9 @@
 //     /usv_fdi/fault_event (usv_fdi_msgs/FaultEvent). Prints, per DiagnosticStatus,
 //       diag level=L hardware_id=H name=<name> | key=value key=value ...
 //     and per mirror sample
-//       mirror mmsi=M sensor=S state=T sequence=Q
+//       mirror mmsi=M sensor=S state=T sequence=Q kind=K c_a=X c_g=Y
+//     and per sample of the transient-local mirror /usv_fdi/status (usv_fdi_msgs/FdiStatus)
+//       status mmsi=M stamp=T armed=0|1 samples=N
 //     until SIGTERM/SIGINT (exit 0).
 //
 // Exit code 3: usage error; 4: DDS error.
@@ -337,11 +339,14 @@ int read_diagnostics(const Options& o) {
       n.reader(n.topic("rt/usv_fdi/fault_event",
                        fdds::TypeSupport(new usv_fdi_msgs::msg::FaultEventPubSubType())),
                true);
+  fdds::DataReader* status = n.reader(
+      n.topic("rt/usv_fdi/status", fdds::TypeSupport(new usv_fdi_msgs::msg::FdiStatusPubSubType())),
+      true);
   fdds::WaitSet ws;
-  diag->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
-  mirror->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
-  ws.attach_condition(diag->get_statuscondition());
-  ws.attach_condition(mirror->get_statuscondition());
+  for (fdds::DataReader* r : {diag, mirror, status}) {
+    r->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+    ws.attach_condition(r->get_statuscondition());
+  }
   std::printf("reading\n");
   std::fflush(stdout);
   while (!probe::g_stop.load()) {
@@ -361,9 +366,16 @@ int read_diagnostics(const Options& o) {
     usv_fdi_msgs::msg::FaultEvent e;
     while (mirror->take_next_sample(&e, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      std::printf("mirror mmsi=%u sensor=%u state=%u sequence=%llu\n", e.mmsi(),
-                  static_cast<unsigned>(e.sensor()), static_cast<unsigned>(e.state()),
-                  static_cast<unsigned long long>(e.sequence_number()));
+      std::printf("mirror mmsi=%u sensor=%u state=%u sequence=%llu kind=%u c_a=%.3f c_g=%.3f\n",
+                  e.mmsi(), static_cast<unsigned>(e.sensor()), static_cast<unsigned>(e.state()),
+                  static_cast<unsigned long long>(e.sequence_number()),
+                  static_cast<unsigned>(e.kind()), e.c_a(), e.c_g());
+    }
+    usv_fdi_msgs::msg::FdiStatus st;
+    while (status->take_next_sample(&st, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      std::printf("status mmsi=%u stamp=%.1f armed=%d samples=%llu\n", st.mmsi(), st.stamp(),
+                  st.armed() ? 1 : 0, static_cast<unsigned long long>(st.samples()));
     }
     std::fflush(stdout);
   }

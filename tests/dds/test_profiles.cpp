@@ -166,8 +166,10 @@ TEST(XmlProfiles, FaultEventQosIsAsSpecified) {
   // A late joiner learns of the latched samples from the writer's heartbeat: Fast DDS's
   // default period of 3 s made late joins of the monitor (and of other vendors' readers)
   // wait up to 3 s. Acknowledgements are repaired as fast.
-  for (const char* name :
-       {profiles::kFaultEventWriter, profiles::kStatusWriter, profiles::kFaultAckWriter}) {
+  // The same for usv-fdi ros2's writers: its keyless mirrors are latched too.
+  for (const char* name : {profiles::kFaultEventWriter, profiles::kStatusWriter,
+                           profiles::kFaultAckWriter, "usv_fdi_ros2_fault_event_writer",
+                           "usv_fdi_ros2_status_writer", "usv_fdi_ros2_diagnostics_writer"}) {
     fdds::DataWriterQos w;
     ASSERT_EQ(ctx.publisher().get_datawriter_qos_from_profile(name, w), ReturnCode_t::RETCODE_OK)
         << name;

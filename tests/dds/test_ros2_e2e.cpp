@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <memory>
@@ -60,16 +61,25 @@ std::optional<Diag> parse_diag(const std::string& line) {
   return d;
 }
 
+/// The number after `key` in a probe line (NaN when absent).
+double number_after(const std::string& line, const std::string& key) {
+  const auto at = line.find(key);
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(line.c_str() + at + key.size(), nullptr);
+}
+
 /// What the /diagnostics reader has seen.
 struct Seen {
   std::map<std::string, Diag> last;                ///< by status name
   std::map<std::string, std::vector<int>> levels;  ///< every level in order, by name
   std::vector<std::string> mirrors;
+  std::vector<std::string> statuses;  ///< lines of the /usv_fdi/status mirror
   std::string text;
 
   void add(const std::string& line) {
     text += line + "\n";
     if (line.rfind("mirror ", 0) == 0) mirrors.push_back(line);
+    if (line.rfind("status ", 0) == 0) statuses.push_back(line);
     const auto d = parse_diag(line);
     if (!d) return;
     auto& l = levels[d->name];
@@ -160,7 +170,7 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
     const Diag& g = seen.last[gyro];
     EXPECT_EQ(g.values.at("state"), "raised");
     EXPECT_GT(std::stod(g.values.at("C_g")), std::stod(g.values.at("C_a")));
-    EXPECT_GT(std::stod(g.values.at("statistic")), std::stod(g.values.at("threshold")));
+    EXPECT_GT(std::stod(g.values.at("J_N")), std::stod(g.values.at("threshold")));
   }
   // THEN the accelerometer goes ERROR, isolated (C_a > C_g)
   ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(accel, 2); }))
@@ -207,8 +217,31 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
       << seen.text << f.log("ros2") << f.log("svc");
   EXPECT_EQ(seen.last[gyro].values.at("state"), "acknowledged");
 
-  // The keyless mirror of the fault events carries the lifecycle too.
+  // The keyless mirror of the fault events carries the lifecycle too: each sensor raised
+  // (STATE_RAISED 1), isolated to it, then acknowledged (STATE_ACKNOWLEDGED 4).
   EXPECT_GE(seen.mirrors.size(), 4u) << seen.text;
+  const auto mirror_has = [&](const std::string& sensor, const std::string& state) {
+    const std::string head = "mirror mmsi=" + ms + " sensor=" + sensor + " state=" + state + " ";
+    for (const auto& l : seen.mirrors) {
+      if (l.rfind(head, 0) == 0) return l;
+    }
+    return std::string();
+  };
+  const std::string gyro_raised = mirror_has("1", "1"), accel_raised = mirror_has("0", "1");
+  ASSERT_FALSE(gyro_raised.empty()) << seen.text;
+  ASSERT_FALSE(accel_raised.empty()) << seen.text;
+  EXPECT_GT(number_after(gyro_raised, "c_g="), number_after(gyro_raised, "c_a=")) << gyro_raised;
+  EXPECT_GT(number_after(accel_raised, "c_a="), number_after(accel_raised, "c_g=")) << accel_raised;
+  // (the acknowledgements' mirror samples may come after the diagnostics that show them)
+  EXPECT_TRUE(read_until(diag.process(), &seen, seconds(10), [&] {
+    return !mirror_has("1", "4").empty() && !mirror_has("0", "4").empty();
+  })) << seen.text;
+  // The status mirror: the vessel's FdiStatus, armed, with the samples it has had.
+  ASSERT_FALSE(seen.statuses.empty()) << seen.text;
+  const std::string& last_status = seen.statuses.back();
+  EXPECT_EQ(last_status.rfind("status mmsi=" + ms + " ", 0), 0u) << last_status;
+  EXPECT_NE(last_status.find(" armed=1 "), std::string::npos) << last_status;
+  EXPECT_GT(number_after(last_status, "samples="), 500.0) << last_status;
 
   // WHEN the sidecar stops, THEN the vessel's statuses go STALE
   f.process("svc").signal(SIGTERM);
@@ -216,6 +249,16 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
   ASSERT_TRUE(read_until(diag.process(), &seen, seconds(30),
                          [&] { return seen.level(accel) == 3 && seen.level(gyro) == 3; }))
       << seen.text << f.log("ros2");
+  // Each status is mirrored once: never more mirror samples than statuses the sidecar sent
+  // ("status uplink (event): N of M statuses sent" in its log).
+  {
+    const std::string svc = f.log("svc");
+    const auto at = svc.find("status uplink (event): ");
+    ASSERT_NE(at, std::string::npos) << svc;
+    const double sent = std::strtod(svc.c_str() + at + 23, nullptr);
+    EXPECT_GT(sent, 0.0) << svc;
+    EXPECT_LE(static_cast<double>(seen.statuses.size()), sent) << seen.text << svc;
+  }
 
   f.process("ros2").signal(SIGTERM);
   ASSERT_TRUE(f.process("ros2").wait_exit(seconds(10)).has_value());

@@ -9,7 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "diagnostic_msgsPubSubTypes.h"
+#include "geometry_msgsPubSubTypes.h"
+#include "nav_msgsPubSubTypes.h"
 #include "ros2_adapter.hpp"
+#include "sensor_msgsPubSubTypes.h"
+#include "std_msgsPubSubTypes.h"
+#include "usv_fdi_msgsPubSubTypes.h"
 
 namespace usvfdi::app::ros2 {
 namespace {
@@ -75,6 +81,27 @@ InsAssembler with_rudder(const AssemblyParams& p, double t = 0.0) {
   InsAssembler a(p);
   a.add_rudder(t, 0.1, true);
   return a;
+}
+
+// The type names on the wire, written out as a ROS 2 node (rmw_fastrtps) registers them: the
+// adapter and the test's probe share the generated types, so only literal names catch a
+// generator that names them otherwise (a reader and writer of different type names never
+// match).
+TEST(Ros2Types, WireTypeNamesAreThoseOfRos2) {
+  EXPECT_STREQ(sensor_msgs::msg::ImuPubSubType().getName(), "sensor_msgs::msg::dds_::Imu_");
+  EXPECT_STREQ(geometry_msgs::msg::TwistStampedPubSubType().getName(),
+               "geometry_msgs::msg::dds_::TwistStamped_");
+  EXPECT_STREQ(nav_msgs::msg::OdometryPubSubType().getName(), "nav_msgs::msg::dds_::Odometry_");
+  EXPECT_STREQ(std_msgs::msg::Float64PubSubType().getName(), "std_msgs::msg::dds_::Float64_");
+  EXPECT_STREQ(diagnostic_msgs::msg::DiagnosticArrayPubSubType().getName(),
+               "diagnostic_msgs::msg::dds_::DiagnosticArray_");
+  EXPECT_STREQ(usv_fdi_msgs::msg::FaultEventPubSubType().getName(),
+               "usv_fdi_msgs::msg::dds_::FaultEvent_");
+  EXPECT_STREQ(usv_fdi_msgs::msg::FdiStatusPubSubType().getName(),
+               "usv_fdi_msgs::msg::dds_::FdiStatus_");
+  // A keyless type: ROS 2 has no keys, and a keyed writer does not match a keyless reader.
+  EXPECT_FALSE(usv_fdi_msgs::msg::FaultEventPubSubType().m_isGetKeyDefined);
+  EXPECT_FALSE(sensor_msgs::msg::ImuPubSubType().m_isGetKeyDefined);
 }
 
 TEST(Ros2Assembly, AnImuSampleWaitsForTheSwaySampleOfItsStamp) {
@@ -357,7 +384,7 @@ TEST(Ros2Diagnostics, OneStatusPerSensorNamedByVesselWithTheEventsValues) {
   EXPECT_EQ(st[1].hardware_id, "257000001");
   EXPECT_EQ(st[1].level, DiagLevel::kError);
   const std::vector<std::pair<std::string, std::string>> want = {
-      {"C_a", "0.000"},    {"C_g", "1.000"},  {"statistic", "14.08"}, {"threshold", "12"},
+      {"C_a", "0.000"},    {"C_g", "1.000"},  {"J_N", "14.08"}, {"threshold", "12"},
       {"state", "raised"}, {"sequence", "3"}, {"kind", "bias"}};
   EXPECT_EQ(st[1].values, want);
 }
