@@ -14,10 +14,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "bam.hpp"  // the bridge alert management system's side of the bridge
 #include "fleet.hpp"
 #include "support.hpp"  // tests/nmea: sentences with checksums
 #include "usv_fdi/nmea/datagram.hpp"
@@ -36,12 +38,10 @@ unsigned test_port(unsigned index) {
   return 20000u + (static_cast<unsigned>(::getpid()) % 10000u) * 4u + index;
 }
 
-/// The service lines of a sidecar reading NMEA on group:port (loopback). Every sentence comes
-/// at the grid rate with its TAG time on the grid, so max_age is below one grid period: a
-/// lost datagram is a gap in the samples, not the previous value held for one more sample
-/// (held, on the noise-free paper scenario, it delays identification, the gyro bias on 20-40 s
-/// goes unseen and a gyro "noise" fault is raised at 40.7 s; docs/integration.md).
-/// max_age: the nmea.max_age line's value ("" : none, the default 1 s).
+/// The service lines of a sidecar reading NMEA on group:port (loopback); max_age: the
+/// nmea.max_age line's value ("" : none, the default 1 s). Every sentence comes at the grid
+/// rate with its TAG time on the grid: a lost datagram is a gap in the samples either way
+/// (held until due, or max_age below one grid period; docs/integration.md, "Lost datagrams").
 std::vector<std::string> nmea_service(unsigned port, const std::vector<std::string>& extra = {},
                                       const std::string& max_age = "0.05") {
   std::vector<std::string> lines = {"input: nmea",
@@ -325,6 +325,124 @@ TEST(NmeaUdpEndToEnd, LostDatagramsAreCountedAndInventNoFault) {
                 (e.sensor == "accelerometer" && e.stamp >= 60.0 && e.stamp < 80.0))
         << dump(ev) << f.log("svc");
   }
+}
+
+TEST(NmeaUdpEndToEnd, FromTheNmeaNetworkToTheBridgeAlertsGarbageIsCountedAndNeverActs) {
+  // GIVEN a sidecar reading NMEA over UDP multicast, a bridge adapter sending its alerts to the
+  // bridge alert management system (the test, on 127.0.0.1), and the noise-free paper scenario
+  // (gyro bias 20-40 s, accelerometer bias 60-80 s) as the simulator's NMEA log
+  Fleet f;
+  const unsigned m = 257300004;
+  const std::string ms = std::to_string(m);
+  const unsigned port = test_port(3);
+  const std::string log_file = f.dir() + "paper.nmea";
+  ASSERT_EQ(f.run_to_end("simlog",
+                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
+                          "--noise-scale", "0", "--nmea", "--output", log_file},
+                         seconds(60), nullptr, false),
+            0);
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(log_file);
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (!line.empty()) lines.push_back(line + "\r\n");
+    }
+  }
+  ASSERT_EQ(lines.size(), 3u * 1001u);
+  // The stream pauses while the gyro fault is acknowledged: the wall-clock INS watchdog waits
+  // longer than that. Statuses at least every 0.5 s: the bridge calls a vessel silent after 2 s.
+  f.start_service(
+      "svc",
+      f.write_service_config(
+          "svc", m,
+          nmea_service(port, {"input_timeout: 600", "status_uplink: {heartbeat: 0.5}"}, "")),
+      0);
+  ASSERT_TRUE(f.wait_for_log("svc", "NMEA input: multicast group", seconds(10))) << f.log("svc");
+  bam_side::Udp bam_rx, bam_tx;
+  const int acn_in = bam_side::free_port();
+  f.start("bridge", {"bridge", "--mmsi", ms, "--out", bam_rx.endpoint(), "--in",
+                     "127.0.0.1:" + std::to_string(acn_in), "--hbt-period", "0.5", "--alc-period",
+                     "1", "--ack-timeout", "5", "--silent-after", "2"});
+  ASSERT_TRUE(f.wait_for_log("bridge", "running", seconds(20))) << f.log("bridge");
+  bam_side::Bam bam;
+  ASSERT_TRUE(bam_side::receive_until(bam_rx, &bam, seconds(20), [&] {
+    return !bam.hbt.empty() && bam.hbt.back().normal;
+  })) << f.log("bridge");
+
+  // Sends samples [from, to) as IEC 61162-450 datagrams, 10 times faster than real time, with
+  // garbage among them: every 25th datagram carries, after its three sentences, a ROT of an
+  // absurd rate, a ROT with a wrong checksum, a truncated sentence and a line that is not
+  // NMEA; every 40th is followed by a datagram of another IEC 61162-450 type and one of bytes.
+  nmea_udp::NmeaUdpSender tx(nmea_udp::Endpoint{kGroup, static_cast<std::uint16_t>(port)},
+                             "127.0.0.1", 0);
+  const std::string absurd = nmea::test::with_checksum("HEROT,99999.0,A") + "\r\n";
+  std::string bad_checksum = nmea::test::with_checksum("HEROT,12.5,A");
+  bad_checksum.back() = bad_checksum.back() == '0' ? '1' : '0';
+  bad_checksum += "\r\n";
+  unsigned garbage_lines = 0;
+  const auto send = [&](std::size_t from, std::size_t to) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t k = from; k < to; ++k) {
+      std::this_thread::sleep_until(t0 + milliseconds(10 * (k - from)));
+      std::string d =
+          std::string(nmea::kIec450Header) + lines[3 * k] + lines[3 * k + 1] + lines[3 * k + 2];
+      if (k % 25 == 7) {
+        d += absurd + bad_checksum + "$HERO\r\n" + "not nmea at all\r\n";
+        garbage_lines += 4;
+      }
+      ASSERT_TRUE(tx.send(d));
+      if (k % 40 == 11) {
+        ASSERT_TRUE(tx.send(std::string("RrUdP\0garbage\r\n", 15)));
+        ASSERT_TRUE(tx.send("\x01\x02\x03\xff\r\n"));
+      }
+    }
+  };
+
+  // WHEN the first 30 s are sent (the gyro bias has begun)
+  send(0, 300);
+  // THEN the gyro's alert is active-unacknowledged (V), the accelerometer's not raised
+  ASSERT_TRUE(bam_side::receive_until(bam_rx, &bam, seconds(30),
+                                      [&] { return bam.state_is(bam_side::kGyro, bam_side::V); }))
+      << bam.dump() << f.log("bridge") << f.log("svc");
+  EXPECT_FALSE(bam.saw(bam_side::kAccel, bam_side::V)) << bam.dump();
+  // WHEN the bridge acknowledges it while the fault lasts
+  bam_tx.send_to(acn_in, bam_side::acn_datagram(bam_side::kGyro, 'A'));
+  // THEN it is active-acknowledged (A)
+  ASSERT_TRUE(bam_side::receive_until(bam_rx, &bam, seconds(20),
+                                      [&] { return bam.state_is(bam_side::kGyro, bam_side::A); }))
+      << bam.dump() << f.log("bridge") << f.log("svc");
+
+  // WHEN the rest of the voyage is sent
+  send(300, 1001);
+  // THEN the gyro's alert, acknowledged and over, is normal (N); the accelerometer's went V,
+  // then rectified-unacknowledged (U)
+  ASSERT_TRUE(bam_side::receive_until(bam_rx, &bam, seconds(60),
+                                      [&] {
+                                        return bam.state_is(bam_side::kGyro, bam_side::N) &&
+                                               bam.state_is(bam_side::kAccel, bam_side::U);
+                                      }))
+      << bam.dump() << f.log("bridge") << f.log("svc");
+  EXPECT_TRUE(bam.saw(bam_side::kAccel, bam_side::V)) << bam.dump();
+  // WHEN the bridge acknowledges it, THEN it is normal too
+  bam_tx.send_to(acn_in, bam_side::acn_datagram(bam_side::kAccel, 'A'));
+  ASSERT_TRUE(bam_side::receive_until(bam_rx, &bam, seconds(20),
+                                      [&] { return bam.state_is(bam_side::kAccel, bam_side::N); }))
+      << bam.dump() << f.log("bridge");
+  // AND the garbage acted on nothing: one alert per sensor's fault, no unknown-sensor alert,
+  // each raised once
+  EXPECT_FALSE(bam.saw(3003, bam_side::V)) << bam.dump();
+  std::set<std::pair<long, int>> distinct;
+  for (const auto& a : bam.alf) {
+    if (a.state == bam_side::V) distinct.insert({a.alert.id, a.revision});
+  }
+  EXPECT_EQ(distinct.size(), 2u) << bam.dump();
+  // AND it was counted by reason and logged
+  EXPECT_GT(garbage_lines, 0u);
+  EXPECT_TRUE(f.wait_for_log("svc", "line(s) refused", seconds(5))) << f.log("svc");
+  const std::string svc = f.log("svc");
+  EXPECT_NE(svc.find("checksum"), std::string::npos) << svc;
+  EXPECT_NE(svc.find("out of range"), std::string::npos) << svc;
 }
 
 }  // namespace
