@@ -71,7 +71,10 @@ struct Ros2Args {
   double diagnostics_period = 1.0;
   bool no_mirrors = false;
   bool reliable = false;
-  bool surge = false;  ///< --surge-from-sway: twist linear.x as the surge speed
+  bool surge = false;                ///< --surge-from-sway: twist linear.x as the surge speed
+  std::string surge_topic;           ///< --surge-topic: a topic of its own (empty: none)
+  std::string surge_type = "twist";  ///< its type: twist (TwistStamped) or odometry
+  bool publishes_surge() const { return surge || !surge_topic.empty(); }
 };
 
 /// One ROS 2 input sample as the listener copies it (usv-fdi signs already).
@@ -88,26 +91,46 @@ struct Input {
 /// into a bounded queue (full: the oldest is dropped and counted).
 class InputQueue : public fdds::DataReaderListener {
  public:
-  InputQueue(int rudder_sign, bool odometry, bool surge)
-      : rudder_sign_(rudder_sign), odometry_(odometry), surge_(surge) {}
+  /// surge: the sway message's linear.x is the surge speed (--surge-from-sway); surge_odometry:
+  /// the type of the surge speed's own topic, if any (Odometry, else TwistStamped).
+  InputQueue(int rudder_sign, bool odometry, bool surge, bool surge_odometry)
+      : rudder_sign_(rudder_sign),
+        odometry_(odometry),
+        surge_(surge),
+        surge_odometry_(surge_odometry) {}
 
-  void set_readers(fdds::DataReader* yaw, fdds::DataReader* sway, fdds::DataReader* rudder) {
+  void set_readers(fdds::DataReader* yaw, fdds::DataReader* sway, fdds::DataReader* rudder,
+                   fdds::DataReader* surge) {
     std::lock_guard<std::mutex> lock(m_);
     yaw_ = yaw;
     sway_ = sway;
     rudder_ = rudder;
+    surge_reader_ = surge;
   }
 
   void on_data_available(fdds::DataReader* reader) override {
     fdds::SampleInfo info;
-    fdds::DataReader *yaw, *sway, *rudder;
+    fdds::DataReader *yaw, *sway, *rudder, *surge;
     {
       std::lock_guard<std::mutex> lock(m_);
       yaw = yaw_;
       sway = sway_;
       rudder = rudder_;
+      surge = surge_reader_;
     }
-    if (reader == yaw) {
+    if (reader == surge && surge_odometry_) {
+      nav_msgs::msg::Odometry m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data) continue;
+        push_surge(m.header(), m.twist().twist().linear().x(), true);
+      }
+    } else if (reader == surge) {
+      geometry_msgs::msg::TwistStamped m;
+      while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
+        if (!info.valid_data) continue;
+        push_surge(m.header(), m.twist().linear().x(), true);
+      }
+    } else if (reader == yaw) {
       sensor_msgs::msg::Imu m;
       while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
         if (!info.valid_data) continue;
@@ -124,7 +147,7 @@ class InputQueue : public fdds::DataReaderListener {
         const double y = m.twist().twist().linear().y();
         push({Input::kSway, stamp_of(m.header()), sent_of(info), ros2::sway_from_rep103(y),
               std::isfinite(y)});
-        push_surge(m.header(), m.twist().twist().linear().x());
+        push_surge(m.header(), m.twist().twist().linear().x(), surge_);
       }
     } else if (reader == sway) {
       geometry_msgs::msg::TwistStamped m;
@@ -133,7 +156,7 @@ class InputQueue : public fdds::DataReaderListener {
         const double y = m.twist().linear().y();
         push({Input::kSway, stamp_of(m.header()), sent_of(info), ros2::sway_from_rep103(y),
               std::isfinite(y)});
-        push_surge(m.header(), m.twist().linear().x());
+        push_surge(m.header(), m.twist().linear().x(), surge_);
       }
     } else if (reader == rudder) {
       std_msgs::msg::Float64 m;
@@ -181,19 +204,20 @@ class InputQueue : public fdds::DataReaderListener {
     cv_.notify_one();
   }
   /// REP 103: x forward, so linear.x is the surge speed with the project's sign.
-  void push_surge(const std_msgs::msg::Header& h, double x) {
-    if (surge_) push({Input::kSurge, stamp_of(h), 0.0, x, std::isfinite(x)});
+  void push_surge(const std_msgs::msg::Header& h, double x, bool wanted) {
+    if (wanted) push({Input::kSurge, stamp_of(h), 0.0, x, std::isfinite(x)});
   }
 
   static constexpr std::size_t kCapacity = 8192;
   const double rudder_sign_;
   const bool odometry_;
   const bool surge_;
+  const bool surge_odometry_;
   mutable std::mutex m_;
   std::condition_variable cv_;
   std::deque<Input> q_;
   std::uint64_t dropped_ = 0;
-  fdds::DataReader *yaw_ = nullptr, *sway_ = nullptr, *rudder_ = nullptr;
+  fdds::DataReader *yaw_ = nullptr, *sway_ = nullptr, *rudder_ = nullptr, *surge_reader_ = nullptr;
 };
 
 /// The ROS 2 side on the context's participant: its types, topics, a publisher and a
@@ -221,7 +245,15 @@ class RosSide {
     yaw_ = reader(imu, listener, mask);
     sway_ = reader(sway, listener, mask);
     rudder_ = reader(rudder, listener, mask);
-    listener->set_readers(yaw_, sway_, rudder_);
+    if (!a.surge_topic.empty()) {
+      fdds::Topic* surge =
+          a.surge_type == "odometry"
+              ? topic(a.surge_topic, fdds::TypeSupport(new nav_msgs::msg::OdometryPubSubType()))
+              : topic(a.surge_topic,
+                      fdds::TypeSupport(new geometry_msgs::msg::TwistStampedPubSubType()));
+      surge_ = reader(surge, listener, mask);
+    }
+    listener->set_readers(yaw_, sway_, rudder_, surge_);
     diagnostics = writer(diag, ros2::kDiagnosticsWriterProfile);
     if (!a.no_mirrors) {
       fault_event = writer(topic("/usv_fdi/fault_event",
@@ -283,7 +315,7 @@ class RosSide {
   fdds::Subscriber* sub_ = nullptr;
   fdds::Publisher* pub_ = nullptr;
   std::vector<fdds::Topic*> topics_;
-  fdds::DataReader *yaw_ = nullptr, *sway_ = nullptr, *rudder_ = nullptr;
+  fdds::DataReader *yaw_ = nullptr, *sway_ = nullptr, *rudder_ = nullptr, *surge_ = nullptr;
 };
 
 void fill_stamp(builtin_interfaces::msg::Time* t, double s) {
@@ -369,7 +401,7 @@ class Adapter {
     rudder_ =
         &ctx.create_writer(dds::TopicId::kRudder, rel ? dds::profiles::kRudderWriterReliable
                                                       : dds::profiles::kRudderWriterBestEffort);
-    if (a.surge) {
+    if (a.publishes_surge()) {
       speed_ =
           &ctx.create_writer(dds::TopicId::kSpeed, rel ? dds::profiles::kRudderWriterReliable
                                                        : dds::profiles::kRudderWriterBestEffort);
@@ -576,7 +608,7 @@ class Adapter {
   bool skew_warned_ = false;
   fdds::DataWriter* ins_ = nullptr;
   fdds::DataWriter* rudder_ = nullptr;
-  fdds::DataWriter* speed_ = nullptr;  ///< --surge-from-sway only
+  fdds::DataWriter* speed_ = nullptr;  ///< --surge-from-sway or --surge-topic only
   std::uint64_t speed_seq_ = 0;
   std::uint64_t ins_seq_ = 0, rudder_seq_ = 0, yaw_in_ = 0, sway_in_ = 0, rudder_in_ = 0;
   std::uint64_t write_failures_ = 0, diag_sent_ = 0;
@@ -594,7 +626,8 @@ int run_ros2(Ros2Args& a) {
     spdlog::error("--rudder-sign must be 1 or -1");
     return kExitUsage;
   }
-  for (const std::string* t : {&a.imu_topic, &a.sway_topic, &a.rudder_topic}) {
+  for (const std::string* t : {&a.imu_topic, &a.sway_topic, &a.rudder_topic, &a.surge_topic}) {
+    if (t == &a.surge_topic && t->empty()) continue;
     if (ros2::dds_topic_of(*t).empty()) {
       spdlog::error("'{}' is not a ROS 2 topic name", *t);
       return kExitUsage;
@@ -612,7 +645,7 @@ int run_ros2(Ros2Args& a) {
   view_args.silent_after = a.silent_after;
   view_args.status = true;  // the FdiStatus mirror
   view_args.once = true;    // FleetView prints nothing on stdout (its changes are ours to log)
-  InputQueue inputs(a.rudder_sign, a.sway_type == "odometry", a.surge);
+  InputQueue inputs(a.rudder_sign, a.sway_type == "odometry", a.surge, a.surge_type == "odometry");
   std::unique_ptr<dds::DdsContext> ctx;
   std::unique_ptr<FleetView> view;
   std::unique_ptr<RosSide> ros;
@@ -626,13 +659,18 @@ int run_ros2(Ros2Args& a) {
     spdlog::error("cannot join DDS domain {}: {}", cfg.domain_id, e.what());
     return kExitFailure;
   }
+  const auto type_name = [](const std::string& t) {
+    return t == "odometry" ? "nav_msgs/Odometry" : "geometry_msgs/TwistStamped";
+  };
+  const std::string surge_from = a.surge_topic.empty() ? std::string()
+                                                       : ", surge from " + a.surge_topic + " (" +
+                                                             type_name(a.surge_type) + " linear.x)";
   spdlog::info(
-      "ros2 adapter for MMSI {}: yaw rate from {} (sensor_msgs/Imu), sway{} from {} ({}), "
+      "ros2 adapter for MMSI {}: yaw rate from {} (sensor_msgs/Imu), sway{} from {} ({}){}, "
       "rudder from {} (std_msgs/Float64, sign {:+d}), diagnostics on /diagnostics{} (domain "
       "{}): running",
-      a.mmsi, a.imu_topic, a.surge ? " and surge" : "", a.sway_topic,
-      a.sway_type == "odometry" ? "nav_msgs/Odometry" : "geometry_msgs/TwistStamped",
-      a.rudder_topic, a.rudder_sign,
+      a.mmsi, a.imu_topic, a.surge ? " and surge" : "", a.sway_topic, type_name(a.sway_type),
+      surge_from, a.rudder_topic, a.rudder_sign,
       !a.no_mirrors ? ", mirrors on /usv_fdi/fault_event and /usv_fdi/status" : "", cfg.domain_id);
   while (wait_for_stop_signal(0.0) == 0) adapter->turn();
   spdlog::info("ros2 adapter stopped: {}", adapter->summary());
@@ -693,9 +731,19 @@ void register_ros2_command(CommandRegistry& registry) {
                 "do not publish /usv_fdi/fault_event and /usv_fdi/status");
   sub->add_flag("--reliable", args.reliable,
                 "write INS and rudder samples RELIABLE (a sidecar with reliable_inputs needs it)");
-  sub->add_flag("--surge-from-sway", args.surge,
-                "also publish the sway message's linear.x (REP 103: forward) as the surge speed "
-                "on usv_fdi/speed, where the engine scales its model with it");
+  CLI::Option* from_sway =
+      sub->add_flag("--surge-from-sway", args.surge,
+                    "also publish the sway message's linear.x (REP 103: forward) as the surge "
+                    "speed on usv_fdi/speed, where the engine scales its model with it");
+  sub->add_option("--surge-topic", args.surge_topic,
+                  "the surge speed from a topic of its own (its linear.x, REP 103: forward; "
+                  "stamped by its header), published on usv_fdi/speed")
+      ->excludes(from_sway);
+  sub->add_option("--surge-type", args.surge_type,
+                  "--surge-topic's type: twist (geometry_msgs/TwistStamped) or odometry "
+                  "(nav_msgs/Odometry)")
+      ->check(CLI::IsMember({"twist", "odometry"}))
+      ->capture_default_str();
 }
 
 }  // namespace usvfdi::app

@@ -14,7 +14,9 @@
 //     REP 103 signs: per sample std_msgs/Float64 rudder (K * δ, default K = 1), then
 //     sensor_msgs/Imu (angular_velocity.z = -r), then geometry_msgs/TwistStamped
 //     (twist.linear.y = -v), stamps t; with --odometry, nav_msgs/Odometry on that topic
-//     (twist.twist.linear.y = -v) instead of the TwistStamped. --qos sensor_data: writers as
+//     (twist.twist.linear.y = -v) instead of the TwistStamped. --surge /topic: also a
+//     geometry_msgs/TwistStamped per sample on that topic, linear.x = kSurgeOwnTopic (1.5 m/s; the
+//     sway message's linear.x is 1). --qos sensor_data: writers as
 //     rclcpp's sensor_data profile (BEST_EFFORT, KEEP_LAST 5). --burst N: the samples go out N at
 //     a time, as a reader sees them when its delivery thread falls behind: the Imu and twist
 //     samples of N instants first, then their N rudder angles, each with the DDS source
@@ -29,7 +31,7 @@
 //     and per mirror sample
 //       mirror mmsi=M sensor=S state=T sequence=Q kind=K c_a=X c_g=Y
 //     and per sample of the transient-local mirror /usv_fdi/status (usv_fdi_msgs/FdiStatus)
-//       status mmsi=M stamp=T armed=0|1 samples=N
+//       status mmsi=M stamp=T armed=0|1 samples=N surge=U
 //     until SIGTERM/SIGINT (exit 0).
 //
 // Exit code 3: usage error; 4: DDS error.
@@ -84,6 +86,7 @@ struct Options {
   int rudder_sign = 1;
   std::string imu = "rt/imu/data", twist = "rt/velocity", rudder = "rt/rudder_angle";
   std::string odometry;  ///< empty: TwistStamped on `twist`
+  std::string surge;     ///< non-empty: a TwistStamped of its own with the surge speed
   bool sensor_data = false;
   unsigned burst = 1;
 };
@@ -121,6 +124,8 @@ Options parse(int argc, char** argv) {
       o.rudder = rt(value);
     } else if (flag == "--odometry") {
       o.odometry = rt(value);
+    } else if (flag == "--surge") {
+      o.surge = rt(value);
     } else if (flag == "--burst") {
       o.burst = static_cast<unsigned>(probe::parse_unsigned(flag, value));
       if (o.burst < 1) throw UsageError("--burst: " + value + " (>= 1)");
@@ -197,9 +202,19 @@ void set_stamp(std_msgs::msg::Header* h, double t) {
   h->stamp().nanosec(static_cast<std::uint32_t>(std::llround((t - whole) * 1e9)) % 1000000000u);
 }
 
+/// The surge speed --surge publishes [m/s]: not the sway message's linear.x (1), so that a reader
+/// can tell which topic it came from.
+constexpr double kSurgeOwnTopic = 1.5;
+
 int publish_paper(const Options& o) {
   Node n(o);
   const bool be = o.sensor_data;
+  fdds::DataWriter* surge_w =
+      o.surge.empty()
+          ? nullptr
+          : n.writer(n.topic(o.surge,
+                             fdds::TypeSupport(new geometry_msgs::msg::TwistStampedPubSubType())),
+                     be);
   fdds::DataWriter* rudder_w =
       n.writer(n.topic(o.rudder, fdds::TypeSupport(new std_msgs::msg::Float64PubSubType())), be);
   fdds::DataWriter* imu_w =
@@ -218,7 +233,11 @@ int publish_paper(const Options& o) {
     rudder_w->get_publication_matched_status(a);
     imu_w->get_publication_matched_status(b);
     twist_w->get_publication_matched_status(c);
-    if (a.current_count > 0 && b.current_count > 0 && c.current_count > 0) break;
+    fdds::PublicationMatchedStatus d;
+    d.current_count = 1;
+    if (surge_w != nullptr) surge_w->get_publication_matched_status(d);
+    if (a.current_count > 0 && b.current_count > 0 && c.current_count > 0 && d.current_count > 0)
+      break;
     if (probe::Clock::now() >= deadline || probe::g_stop.load()) {
       std::printf("no reader matched\n");
       return 2;
@@ -248,6 +267,7 @@ int publish_paper(const Options& o) {
     sensor_msgs::msg::Imu imu;
     geometry_msgs::msg::TwistStamped twist;
     nav_msgs::msg::Odometry odom;
+    geometry_msgs::msg::TwistStamped surge;
     double sent = 0.0;
   };
   std::vector<Instant> burst;
@@ -264,6 +284,7 @@ int publish_paper(const Options& o) {
     } else {
       write_at(twist_w, &x.odom, sent);
     }
+    if (surge_w != nullptr) write_at(surge_w, &x.surge, sent);
   };
   const auto write_burst = [&] {
     if (burst.empty()) return;
@@ -304,6 +325,8 @@ int publish_paper(const Options& o) {
     x.twist.twist().linear().x(1.0);
     x.twist.twist().linear().y(-row.v);  // REP 103: y to port
     x.twist.twist().angular().z(-row.r);
+    x.surge.header(x.twist.header());
+    x.surge.twist().linear().x(kSurgeOwnTopic);
     if (!o.odometry.empty()) {
       x.odom.header(x.twist.header());
       x.odom.header().frame_id("odom");
@@ -374,8 +397,9 @@ int read_diagnostics(const Options& o) {
     usv_fdi_msgs::msg::FdiStatus st;
     while (status->take_next_sample(&st, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      std::printf("status mmsi=%u stamp=%.1f armed=%d samples=%llu\n", st.mmsi(), st.stamp(),
-                  st.armed() ? 1 : 0, static_cast<unsigned long long>(st.samples()));
+      std::printf("status mmsi=%u stamp=%.1f armed=%d samples=%llu surge=%.3f\n", st.mmsi(),
+                  st.stamp(), st.armed() ? 1 : 0, static_cast<unsigned long long>(st.samples()),
+                  st.surge_speed());
     }
     std::fflush(stdout);
   }

@@ -144,7 +144,7 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
       "svc",
       f.write_service_config("svc", m, {"input_timeout: 600", "status_uplink: {heartbeat: 1}"}), 0);
   f.start("ros2", {"ros2", "--mmsi", ms, "--rudder-sign", "-1", "--reliable", "--silent-after", "3",
-                   "--diagnostics-period", "0.5"});
+                   "--diagnostics-period", "0.5", "--surge-topic", "/speed_through_water"});
   ASSERT_TRUE(f.wait_for_log("ros2", "running", seconds(20))) << f.log("ros2");
   Ros2Probe diag(f, "diag", "read-diagnostics", {});
   Seen seen;
@@ -160,7 +160,9 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
   // sensor topic of either kind), so a starved adapter loses samples: at 10x a CI-loaded run
   // missed the 2 s (wall) gyro fault, and at 4x with a 60 s lead-in the longer stream under
   // ThreadSanitizer lost enough to raise false faults. 2x keeps the adapter's load low.
-  Ros2Probe pub(f, "pub", "publish-paper", {"--speed", "2", "--rudder-sign", "-1"});
+  // The surge speed on a topic of its own (TwistStamped, linear.x 1.5 m/s).
+  Ros2Probe pub(f, "pub", "publish-paper",
+                {"--speed", "2", "--rudder-sign", "-1", "--surge", "/speed_through_water"});
 
   // THEN the gyro goes ERROR first (the accelerometer still OK), isolated (C_g > C_a)
   ASSERT_TRUE(read_until(diag.process(), &seen, seconds(90), [&] { return seen.saw(gyro, 2); }))
@@ -242,6 +244,8 @@ TEST(Ros2EndToEnd, PaperScenarioFromRos2TopicsRaisesBothFaultsOnDiagnosticsUntil
   EXPECT_EQ(last_status.rfind("status mmsi=" + ms + " ", 0), 0u) << last_status;
   EXPECT_NE(last_status.find(" armed=1 "), std::string::npos) << last_status;
   EXPECT_GT(number_after(last_status, "samples="), 500.0) << last_status;
+  // The surge speed of its own topic reached the engine (not the sway message's linear.x, 1).
+  EXPECT_DOUBLE_EQ(number_after(last_status, "surge="), 1.5) << last_status;
 
   // WHEN the sidecar stops, THEN the vessel's statuses go STALE
   f.process("svc").signal(SIGTERM);
