@@ -532,12 +532,13 @@ class Adapter {
     // The age in the STALE message is in whole seconds, so that a silent sidecar does not make
     // every turn a change (at most one a second, the period).
     // The vessel's FdiStatus adds what its latched faults do not say (stale inputs, a model
-    // mismatch).
+    // mismatch, a suspicion).
     ros2::VesselNotes notes;
     const auto* vessels = view_.vessels();
     const VesselStatus* vs = vessels == nullptr ? nullptr : vessels->shown(a_.mmsi);
     if (vs != nullptr && vs->alive) {
-      notes = ros2::vessel_notes(vs->st.isolation_paused(), vs->st.input_flags());
+      notes = ros2::vessel_notes(vs->st.isolation_paused(), vs->st.input_flags(), vs->st.j_peak(),
+                                 vs->st.j_raise(), vs->st.j_leave());
     }
     auto statuses = ros2::vessel_diagnostics(
         a_.mmsi, [&](Sensor s) { return row_of(s); }, age, a_.silent_after, notes);

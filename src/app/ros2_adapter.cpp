@@ -203,6 +203,20 @@ VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_fla
   return n;
 }
 
+VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_flags,
+                         const std::array<double, 2>& j_peak, const std::array<double, 2>& j_raise,
+                         const std::array<double, 2>& j_leave) {
+  VesselNotes n = vessel_notes(isolation_paused, input_flags);
+  for (int c = 0; c < 2; ++c) {
+    n.j_peak[c] = j_peak[c];
+    n.j_raise[c] = j_raise[c];
+    n.j_leave[c] = j_leave[c];
+    // (NaN peak: none computed; a comparison with NaN is false)
+    n.suspected[c] = j_leave[c] > 0.0 && j_peak[c] > j_leave[c];
+  }
+  return n;
+}
+
 namespace {
 
 /// Why the sidecar cannot judge `sensor` now ("": it can).
@@ -230,12 +244,23 @@ void add_vessel_notes(const VesselNotes& notes, Sensor sensor, DiagStatus* d) {
       return;
     }
   }
-  if (d->level != DiagLevel::kOk || !notes.model_mismatch) return;
+  if (d->level != DiagLevel::kOk) return;
+  if (notes.model_mismatch) {
+    d->level = DiagLevel::kWarn;
+    d->message =
+        "model mismatch, not a sensor fault: the vessel's dynamics differ from the identified "
+        "model (" +
+        d->message + ")";
+    return;
+  }
+  const int c = sensor == Sensor::kAccelerometer ? 0 : sensor == Sensor::kGyro ? 1 : -1;
+  if (c < 0 || !notes.suspected[c]) return;
   d->level = DiagLevel::kWarn;
-  d->message =
-      "model mismatch, not a sensor fault: the vessel's dynamics differ from the identified "
-      "model (" +
-      d->message + ")";
+  d->message = fmt::format(
+      "suspected: the {} channel's residual J_N {:.3g} is above the level that clears a fault "
+      "({:.3g}), not at the one that raises it ({:.3g}) ({})",
+      c == 0 ? "accelerometer" : "gyro", notes.j_peak[c], notes.j_leave[c], notes.j_raise[c],
+      d->message);
 }
 
 DiagStatus instance_diagnostic(std::uint32_t mmsi, Sensor sensor, const Row* row, double heard_age,

@@ -11,6 +11,7 @@
 // Imu samples on the DDS source timestamps (the writers' clocks).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -190,10 +191,17 @@ struct DiagStatus {
 DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, double silent_after);
 
 /// What the vessel's FdiStatus says beyond its latched faults.
-/// (Not a suspicion: PAUSE_FAULT is set on every freeze of identification, also on healthy
-/// data whose residual passes half its threshold, and for 10 s after a clear.)
+/// (PAUSE_FAULT is no suspicion: it is set on every freeze of identification, and for 10 s
+/// after a clear.)
 struct VesselNotes {
   bool model_mismatch = false;  ///< isolation_paused & PAUSE_MODEL_MISMATCH
+  /// A suspicion per channel [accelerometer, gyro]: the status's peak J_N above the threshold
+  /// that clears a fault (j_leave > 0: one is in force), not yet at the one that raises. The
+  /// peak, the leave and the raise thresholds, for the message.
+  bool suspected[2] = {false, false};
+  double j_peak[2] = {0.0, 0.0};
+  double j_leave[2] = {0.0, 0.0};
+  double j_raise[2] = {0.0, 0.0};
   // Inputs the sidecar cannot judge a sensor from now (input_flags, fdi::INPUT_*).
   bool ins_silent = false;      ///< INPUT_INS_SILENT
   bool rudder_missing = false;  ///< INPUT_RUDDER_MISSING (FDI paused)
@@ -202,6 +210,11 @@ struct VesselNotes {
 };
 /// From a status's isolation pause flags (fdi::PAUSE_*) and input flags (fdi::INPUT_*).
 VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_flags = 0);
+/// The same, with the status's residual statistics (FdiStatus version 4: j_peak, j_raise,
+/// j_leave per channel [accelerometer, gyro]) for the suspicions.
+VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_flags,
+                         const std::array<double, 2>& j_peak, const std::array<double, 2>& j_raise,
+                         const std::array<double, 2>& j_leave);
 
 /// The statuses of one vessel: "usv_fdi: <mmsi> accelerometer" and "... gyro" always,
 /// "... unknown" once the sidecar has published that instance. hardware_id is the MMSI;
@@ -210,7 +223,7 @@ VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_fla
 /// be OK or WARN is STALE while the heard sidecar reports its input stale (the INS silent, no
 /// usable rudder angle, or the sensor's own channel unusable: it cannot judge the sensor now;
 /// a raised fault stays ERROR); one that would be OK is WARN while the vessel reports a model
-/// mismatch (not a sensor fault).
+/// mismatch (not a sensor fault), else while its channel is suspected (VesselNotes::suspected).
 template <class RowOf>
 std::vector<DiagStatus> vessel_diagnostics(std::uint32_t mmsi, RowOf row_of, double heard_age,
                                            double silent_after, const VesselNotes& notes = {});

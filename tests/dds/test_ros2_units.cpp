@@ -412,6 +412,39 @@ TEST(Ros2Diagnostics, AModelMismatchIsAWarningNotAnError) {
   EXPECT_EQ(vessel_diagnostics(257000001, none, 0.1, 5.0, other)[0].level, DiagLevel::kOk);
 }
 
+TEST(Ros2Diagnostics, AResidualAboveItsClearLevelIsASuspicionWarning) {
+  const auto none = [](Sensor) -> const Row* { return nullptr; };
+  // GIVEN a status whose gyro residual peaked at 4.2, between the level that clears (3) and
+  // the one that raises (6), and whose accelerometer residual is low
+  const VesselNotes n = vessel_notes(0, 0, {1.0, 4.2}, {6.0, 6.0}, {3.0, 3.0});
+  EXPECT_FALSE(n.suspected[0]);
+  EXPECT_TRUE(n.suspected[1]);
+  // THEN the gyro is WARN "suspected", with the numbers; the accelerometer OK
+  const auto d = vessel_diagnostics(257000001, none, 0.1, 5.0, n);
+  EXPECT_EQ(d[0].level, DiagLevel::kOk) << d[0].message;
+  EXPECT_EQ(d[1].level, DiagLevel::kWarn);
+  EXPECT_NE(d[1].message.find("suspected: the gyro channel's residual J_N 4.2 is above the level "
+                              "that clears a fault (3), not at the one that raises it (6)"),
+            std::string::npos)
+      << d[1].message;
+  // AND a raised gyro fault stays ERROR, a silent sidecar STALE, a model mismatch says so
+  const Row g = row(Sensor::kGyro, FaultState::kRaised);
+  EXPECT_EQ(
+      vessel_diagnostics(
+          257000001, [&](Sensor s) { return s == Sensor::kGyro ? &g : nullptr; }, 0.1, 5.0, n)[1]
+          .level,
+      DiagLevel::kError);
+  EXPECT_EQ(vessel_diagnostics(257000001, none, 9.0, 5.0, n)[1].level, DiagLevel::kStale);
+  const VesselNotes both =
+      vessel_notes(fdi::PAUSE_MODEL_MISMATCH, 0, {1.0, 4.2}, {6.0, 6.0}, {3.0, 3.0});
+  EXPECT_NE(vessel_diagnostics(257000001, none, 0.1, 5.0, both)[1].message.find("model mismatch"),
+            std::string::npos);
+  // AND no suspicion without thresholds in force (not armed: 0) or without a statistic (NaN)
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(vessel_notes(0, 0, {9.0, 9.0}, {0.0, 0.0}, {0.0, 0.0}).suspected[1]);
+  EXPECT_FALSE(vessel_notes(0, 0, {nan, nan}, {6.0, 6.0}, {3.0, 3.0}).suspected[1]);
+}
+
 TEST(Ros2Diagnostics, AStaleInputOfAHeardSidecarIsStaleForTheSensorsItConcerns) {
   const auto none = [](Sensor) -> const Row* { return nullptr; };
   // GIVEN a heard sidecar whose gyro channel is unusable (INPUT_GYRO_UNUSABLE)
