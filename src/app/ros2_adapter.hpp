@@ -218,7 +218,7 @@ VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_fla
 
 /// The statuses of one vessel: "usv_fdi: <mmsi> accelerometer" and "... gyro" always,
 /// "... unknown" once the sidecar has published that instance. hardware_id is the MMSI;
-/// values C_a, C_g, statistic (J_N), threshold, state, sequence, kind.
+/// values C_a, C_g, J_N (the event's statistic), threshold, state, sequence, kind.
 /// `row_of(sensor)` gives the vessel's instance of a sensor or nullptr. A sensor that would
 /// be OK or WARN is STALE while the heard sidecar reports its input stale (the INS silent, no
 /// usable rudder angle, or the sensor's own channel unusable: it cannot judge the sensor now;
