@@ -2,23 +2,29 @@
 # What lost NMEA datagrams do to the faults raised, for both ways of holding a value on the
 # sample grid (usv-fdi replay --nmea-hold due | max-age; docs/integration.md, "Lost datagrams").
 #
-#   scripts/bench-nmea-loss.sh [--every N] [--seeds "1 2 3 4"] [--noise "0 0.2 1"] [--build DIR]
+#   scripts/bench-nmea-loss.sh [--every N] [--jitter MS] [--seeds "1 2 3 4"] [--noise "0 0.2 1"]
+#                              [--build DIR]
 #
 # For each vessel (otter, mariner), scenario (faults, healthy), seed and noise scale, the
 # simulator writes the voyage as an NMEA log (ROT, RSA, VBW per 10 Hz sample, TAG times); a copy
-# loses every N-th sample's datagram (its three lines). Both logs are replayed with each hold.
+# loses every N-th sample's datagram (its three lines). With --jitter, every line's TAG time
+# c: of both logs moves by a uniform random -MS..+MS ms (seeded), as a sender's clock and
+# scheduler would put it: the times then straddle the sample grid. Both logs are replayed with
+# each hold.
 # A raised event of the lossy replay with no raised event of the same sensor within 5 s in the
 # lossless replay (same hold) is "invented"; one of the lossless replay with none in the lossy
 # replay is "lost". Prints one table row per noise scale and hold (sums over the runs).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 every=37
+jitter=0
 seeds="1 2 3 4"
 noise="0 0.2 1"
 build="$here/build"
 while [ $# -gt 0 ]; do
   case "$1" in
     --every) every="$2"; shift 2 ;;
+    --jitter) jitter="$2"; shift 2 ;;
     --seeds) seeds="$2"; shift 2 ;;
     --noise) noise="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
@@ -45,9 +51,40 @@ for ns in $noise; do
         f="$work/ns$ns-$v-$sc-$seed"
         "$exe" sim --vessel "$v" --scenario "$sc" --rate 10 --seed "$seed" --noise-scale "$ns" \
           --nmea --output "$f.nmea" 2>/dev/null
-        # three lines per sample (ROT, RSA, VBW): drop every N-th sample's
-        awk -v n="$every" 'NF { k = int(c / 3); c++; if (k % n != n - 1) print }' "$f.nmea" \
-          >"$f-lossy.nmea"
+        python3 - "$f.nmea" "$every" "$jitter" "$seed" <<'EOF'
+import random, re, sys
+path, every, jitter_ms, seed = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+rng = random.Random(seed)
+
+def in_ms(c):
+    # the simulator writes whole seconds in seconds, the rest in milliseconds
+    return c * 1000 if c < 10**11 else c
+
+def jittered(line):
+    # \s:..,c:MS*hh\$... : move c: and recompute the TAG block's checksum
+    m = re.match(r"\\([^*]*)\*[0-9A-Fa-f]{2}\\(.*)", line)
+    if not m or jitter_ms == 0:
+        return line
+    body = re.sub(r"c:(\d+)", lambda c: "c:%d" % (in_ms(int(c.group(1))) + round(rng.uniform(-jitter_ms, jitter_ms))), m.group(1))
+    x = 0
+    for ch in body:
+        x ^= ord(ch)
+    return "\\%s*%02X\\%s" % (body, x, m.group(2))
+
+def tag_time(line):
+    m = re.search(r"c:(\d+)", line)
+    return in_ms(int(m.group(1))) if m else 0
+
+lines = [l.rstrip("\r\n") for l in open(path) if l.strip()]
+lines = [jittered(l) for l in lines]
+with open(path, "w") as full, open(path[: -len(".nmea")] + "-lossy.nmea", "w") as lossy:
+    for k in range(len(lines) // 3):  # three lines per sample: ROT, RSA, VBW
+        # in the order of their (jittered) times, as they would arrive
+        rows = "".join(l + "\n" for l in sorted(lines[3 * k : 3 * k + 3], key=tag_time))
+        full.write(rows)
+        if k % every != every - 1:
+            lossy.write(rows)
+EOF
         for in in "$f" "$f-lossy"; do
           for h in max-age due; do
             "$exe" replay --config "$here/config/vessels/$v.yaml" --input "$in.nmea" \
@@ -59,10 +96,10 @@ for ns in $noise; do
   done
 done
 
-python3 - "$work" "$every" "$noise" <<'EOF'
+python3 - "$work" "$every" "$noise" "$jitter" <<'EOF'
 import glob, json, os, sys
 
-work, every, noises = sys.argv[1], sys.argv[2], sys.argv[3].split()
+work, every, noises, jitter = sys.argv[1], sys.argv[2], sys.argv[3].split(), sys.argv[4]
 
 def raised(path):
     out = []
@@ -76,7 +113,7 @@ def raised(path):
 def unmatched(a, b, tol=5.0):
     return [x for x in a if not any(x[0] == y[0] and abs(x[1] - y[1]) <= tol for y in b)]
 
-print(f"every {every}th datagram lost; raised events summed over the runs\n")
+print(f"every {every}th datagram lost, TAG times +-{jitter} ms; raised events summed over the runs\n")
 print("| noise scale | hold | runs | raised, lossless | raised, lossy | invented | lost |")
 print("|---|---|---|---|---|---|---|")
 for ns in noises:

@@ -230,9 +230,10 @@ void register_replay_command(CommandRegistry& registry) {
                   "sentence")
       ->check(CLI::PositiveNumber);
   sub->add_option("--nmea-hold", args->nmea_hold,
-                  "NMEA: how long a value is held on the sample grid: due (until its sentence's "
-                  "next is due, the period learned from the log; a lost sentence is a gap) or "
-                  "max-age (up to the max age, zero-order hold)")
+                  "NMEA: how values are put on the sample grid: due (each at the grid time "
+                  "nearest it, never twice once its sentence's next is due, the period learned "
+                  "from the log: a lost sentence is a gap) or max-age (the latest at or before "
+                  "the grid time, held up to the max age: zero-order hold)")
       ->check(CLI::IsMember({"due", "max-age"}))
       ->capture_default_str();
   sub->add_option("--output", args->output, "output JSON Lines file (default: stdout)");

@@ -13,6 +13,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMinTolerance = 0.002;  ///< [s]: jitter below this is not told apart
 constexpr double kMadsOfJitter = 4.5;    ///< ~3 standard deviations of Gaussian jitter
 constexpr double kMaxScatter = 0.25;     ///< MAD / period beyond which a sentence is irregular
+/// The share of intervals that must be whole multiples of the period (a lost sentence makes
+/// one of 2 P): two senders of one sentence, or a sender that repeats it, make a pattern of
+/// short and long intervals whose median is neither, and no period.
+constexpr double kMinOnPeriod = 0.8;
+/// Intervals outside period +- tolerance in a row that restart the learning (a new rate).
+constexpr int kOffPeriodRestart = 3;
 
 double median_of(double* x, int n) {
   std::nth_element(x, x + n / 2, x + n);
@@ -23,12 +29,29 @@ double median_of(double* x, int n) {
 }  // namespace
 
 void SampleAssembler::Arrivals::arrive(double t) {
+  if (std::isnan(last)) {
+    last = t;
+    return;
+  }
   const double dt = t - last;
+  // Another line of the same datagram, or a copy of the sentence: the same arrival.
+  if (dt < kMinTolerance) return;
   last = t;
-  if (!(dt > 0.0)) return;  // the first arrival, or another line of the same datagram
+  // A new rate: the last few intervals all off the learned period; learn again from them.
+  off_period = !std::isnan(period) && std::abs(dt - period) > tolerance ? off_period + 1 : 0;
   intervals[next] = dt;
   next = (next + 1) % kKeptIntervals;
   count = std::min(count + 1, kKeptIntervals);
+  if (off_period >= kOffPeriodRestart) {
+    double recent[kOffPeriodRestart];
+    for (int i = 0; i < kOffPeriodRestart; ++i) {
+      recent[i] = intervals[(next - kOffPeriodRestart + i + kKeptIntervals) % kKeptIntervals];
+    }
+    std::copy(recent, recent + kOffPeriodRestart, intervals);
+    count = kOffPeriodRestart;
+    next = kOffPeriodRestart;
+    off_period = 0;
+  }
   period = kNaN;
   if (count < kMinIntervals) return;
   double x[kKeptIntervals];
@@ -37,8 +60,15 @@ void SampleAssembler::Arrivals::arrive(double t) {
   for (int i = 0; i < count; ++i) x[i] = std::abs(x[i] - p);
   const double mad = median_of(x, count);
   if (mad > kMaxScatter * p) return;  // not periodic: held up to max_age_s
+  const double tol = std::max(kMadsOfJitter * mad, kMinTolerance);
+  int on_period = 0;
+  for (int i = 0; i < count; ++i) {
+    const double k = std::round(intervals[i] / p);
+    on_period += k >= 1.0 && std::abs(intervals[i] - k * p) <= std::max(tol, p / 8.0);
+  }
+  if (on_period < kMinOnPeriod * count) return;
   period = p;
-  tolerance = std::max(kMadsOfJitter * mad, kMinTolerance);
+  tolerance = tol;
 }
 
 SampleAssembler::Feed SampleAssembler::feed_of(Slot slot) {
@@ -72,6 +102,7 @@ SampleAssembler::SampleAssembler(const AssemblerConfig& config) : config_(config
                                 std::to_string(config.max_age_s));
   }
   period_ = 1.0 / config.rate_hz;
+  look_ahead_ = config.hold_until_due ? 0.5 * period_ : 0.0;
 }
 
 bool SampleAssembler::accept_time(double t) {
@@ -82,9 +113,9 @@ bool SampleAssembler::accept_time(double t) {
   if (!started_) {
     started_ = true;
     first_input_ = t;
-    next_k_ = first_grid_index(t, false);
+    next_k_ = first_grid_index(t - look_ahead_, false);
   }
-  emit_before(t, false);
+  emit_before(t - look_ahead_, false);
   latest_input_ = t;
   return true;
 }
@@ -182,10 +213,12 @@ double SampleAssembler::at(Slot slot, double g, double* age) {
   *age = kNaN;
   if (std::isnan(h.value) || !(g - h.time <= config_.max_age_s)) return kNaN;
   const Arrivals& a = arrivals_[feed_of(slot)];
-  if (config_.hold_until_due && !std::isnan(a.period)) {
-    const double due = h.time + a.period;
-    if (g >= due + a.tolerance) return kNaN;            // the successor is overdue
-    if (h.used && g >= due - a.tolerance) return kNaN;  // due now: not the old value again
+  // Already in a sample, and its successor due by g's look-ahead time: the successor is lost
+  // or late, and the value is not given again. (One not yet used is given, however late its
+  // successor: it is no repetition.)
+  if (config_.hold_until_due && !std::isnan(a.period) && h.used &&
+      g + look_ahead_ >= h.time + a.period - a.tolerance) {
+    return kNaN;
   }
   h.used = true;
   *age = g - h.time;
@@ -202,7 +235,11 @@ void SampleAssembler::emit_before(double t, bool inclusive) {
     s.r = at(kR, g, &s.age_r);
     s.delta = at(kDelta, g, &s.age_delta);
     s.u = at(kUWater, g, &s.age_u);
-    if (std::isnan(s.u)) s.u = at(kUGround, g, &s.age_u);
+    // The ground speed stands in only when there is no water speed (invalid or too old), not
+    // where a water speed is withheld as a repetition: u would flip between the two.
+    const Held& water = held_[kUWater];
+    const bool water_held = !std::isnan(water.value) && g - water.time <= config_.max_age_s;
+    if (std::isnan(s.u) && !water_held) s.u = at(kUGround, g, &s.age_u);
     const bool any =
         !std::isnan(s.v) || !std::isnan(s.r) || !std::isnan(s.delta) || !std::isnan(s.u);
     if (!any) {

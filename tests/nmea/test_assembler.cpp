@@ -67,34 +67,43 @@ TEST(Assembler, UnitsAndSignsOfTheShippedVessels) {
 }
 
 TEST(Assembler, DifferentRatesOnOneGrid) {
-  SampleAssembler a(AssemblerConfig{});
-  // ROT at 20 Hz, RSA at 5 Hz, VBW at 1 Hz over 2 s, starting between grid times.
-  for (int i = 0; i <= 40; ++i) {
-    const double t = 100.01 + 0.05 * i;
-    a.add(t, rot(i));
-    if (i % 4 == 0) a.add(t, rsa(0.5 * i));
-    if (i % 20 == 0) a.add(t, vbw(4.0, 0.1 * i));
-  }
-  a.advance(102.05);
-  const auto s = a.take();
-  ASSERT_FALSE(s.empty());
-  EXPECT_NEAR(s.front().t, 100.1, 1e-9);  // the grid is k / rate
-  for (std::size_t k = 1; k < s.size(); ++k) EXPECT_NEAR(s[k].t - s[k - 1].t, 0.1, 1e-9);
-  EXPECT_NEAR(s.back().t, 102.0, 1e-9);
-  for (const auto& x : s) {
-    // The latest ROT at or before t: i = floor((t - 100.01) / 0.05).
-    const int i = static_cast<int>(std::floor((x.t - 100.01) / 0.05 + 1e-9));
-    EXPECT_NEAR(x.r, yaw_rate_from_rot(i), 1e-12) << x.t;
-    EXPECT_NEAR(x.age_r, x.t - (100.01 + 0.05 * i), 1e-9);
-    const int j = i - i % 4;
-    EXPECT_NEAR(x.delta, delta_from_rsa(0.5 * j, RudderSign::kPositiveToPort), 1e-12) << x.t;
-    EXPECT_FALSE(std::isnan(x.v)) << x.t;  // VBW at 1 Hz, held within max_age = 1 s
-    EXPECT_LE(x.age_v, 1.0);
+  for (const bool until_due : {false, true}) {
+    // Held until due, a value goes to the grid time nearest it: the look time is half a grid
+    // period after the grid time.
+    const double look = until_due ? 0.05 : 0.0;
+    AssemblerConfig c;
+    c.hold_until_due = until_due;
+    SampleAssembler a(c);
+    // ROT at 20 Hz, RSA at 5 Hz, VBW at 1 Hz over 2 s, starting between grid times.
+    for (int i = 0; i <= 40; ++i) {
+      const double t = 100.01 + 0.05 * i;
+      a.add(t, rot(i));
+      if (i % 4 == 0) a.add(t, rsa(0.5 * i));
+      if (i % 20 == 0) a.add(t, vbw(4.0, 0.1 * i));
+    }
+    a.advance(102.05);
+    const auto s = a.take();
+    ASSERT_FALSE(s.empty());
+    EXPECT_NEAR(s.front().t, until_due ? 100.0 : 100.1, 1e-9);  // the grid is k / rate
+    for (std::size_t k = 1; k < s.size(); ++k) EXPECT_NEAR(s[k].t - s[k - 1].t, 0.1, 1e-9);
+    EXPECT_NEAR(s.back().t, 102.0, 1e-9);
+    for (const auto& x : s) {
+      // The latest ROT at or before the look time: i = floor((t + look - 100.01) / 0.05).
+      const int i = static_cast<int>(std::floor((x.t + look - 100.01) / 0.05 + 1e-9));
+      EXPECT_NEAR(x.r, yaw_rate_from_rot(i), 1e-12) << x.t;
+      EXPECT_NEAR(x.age_r, x.t - (100.01 + 0.05 * i), 1e-9);
+      const int j = i - i % 4;
+      EXPECT_NEAR(x.delta, delta_from_rsa(0.5 * j, RudderSign::kPositiveToPort), 1e-12) << x.t;
+      EXPECT_FALSE(std::isnan(x.v)) << x.t;  // VBW at 1 Hz, held within max_age = 1 s
+      EXPECT_LE(x.age_v, 1.0);
+    }
   }
 }
 
 TEST(Assembler, SampleUsesOnlyInputsAtOrBeforeItsTime) {
-  SampleAssembler a(AssemblerConfig{});
+  AssemblerConfig c;
+  c.hold_until_due = false;  // the look time is the grid time
+  SampleAssembler a(c);
   a.add(0.05, rot(1.0));
   a.add(0.15, rot(2.0));  // emits 0.1 before applying this
   a.add(0.2, rot(3.0));   // exactly on the grid: in the sample at 0.2
@@ -171,50 +180,122 @@ TEST(Assembler, ALostSentenceIsAGapNotTheOldValueAgain) {
   }
 }
 
-// Sentences whose times straddle the grid (the receive clock, a sender's jitter): each sample
-// has the latest ROT measured at or before its time, except where that ROT is already in the
-// previous sample while the next was due: a gap there, never the same value twice.
-TEST(Assembler, JitterAroundTheGridNeverRepeatsAValue) {
+// Sentences sent at the grid rate whose times straddle the grid (the time base starts at the
+// first one, so they lie on it; the sender's jitter puts them before or after): each value goes
+// to the grid time nearest it, every sample has its own ROT, none twice; a lost ROT is a gap.
+// Held up to max_age (the look time the grid time), the ROTs just after their grid time are
+// repeats of the one before.
+TEST(Assembler, JitterAroundTheGridGoesToTheNearestGridTime) {
+  for (const double jitter : {0.0015, 0.02}) {
+    for (const bool until_due : {false, true}) {
+      AssemblerConfig c;
+      c.hold_until_due = until_due;
+      SampleAssembler a(c);
+      for (int i = 0; i < 200; ++i) {
+        if (i == 120) continue;  // lost
+        a.add(0.1 * i + jitter * std::sin(1.7 * i), rot(i));
+      }
+      a.advance(0.1 * 199);
+      const auto s = a.take();
+      int repeats = 0;
+      double previous = std::nan("");
+      for (const auto& x : s) {
+        const int i = static_cast<int>(std::lround(x.t / 0.1));
+        repeats += x.r == previous;
+        if (!std::isnan(x.r)) previous = x.r;
+        if (!until_due) continue;
+        if (i == 120) {
+          EXPECT_TRUE(std::isnan(x.r)) << "jitter " << jitter;
+        } else {
+          EXPECT_NEAR(x.r, yaw_rate_from_rot(i), 1e-15) << x.t << " jitter " << jitter;
+        }
+      }
+      if (until_due) {
+        EXPECT_EQ(s.size(), 199u) << "jitter " << jitter;  // 120 lost: no sample there
+        EXPECT_EQ(repeats, 0) << "jitter " << jitter;
+        EXPECT_NEAR(a.learned_period("ROT"), 0.1, 4 * jitter);
+      } else {
+        EXPECT_GT(repeats, 20) << "jitter " << jitter;
+      }
+    }
+  }
+}
+
+// Two senders of one sentence on the group (two talkers, a doubled datagram on the receive
+// clock): the intervals alternate short and long, no period is learned, and the values are
+// held up to max_age_s as before. A copy within 2 ms is the same arrival.
+TEST(Assembler, TwoSendersOfOneSentenceTeachNoPeriod) {
+  SampleAssembler a(AssemblerConfig{});
+  SampleAssembler copies(AssemblerConfig{});
+  for (int i = 0; i < 100; ++i) {
+    a.add(0.1 * i + 0.01, rot(i));
+    a.add(0.1 * i + 0.04, rot(i + 0.5));  // the second talker, 30 ms later
+    copies.add(0.1 * i + 0.01, rot(i));
+    copies.add(0.1 * i + 0.0105, rot(i));  // the same datagram again, 0.5 ms later
+  }
+  a.advance(9.9);
+  copies.advance(9.9);
+  EXPECT_TRUE(std::isnan(a.learned_period("ROT")));
+  for (const auto& x : a.take()) EXPECT_FALSE(std::isnan(x.r)) << x.t;
+  EXPECT_NEAR(copies.learned_period("ROT"), 0.1, 1e-9);
+  for (const auto& x : copies.take()) EXPECT_FALSE(std::isnan(x.r)) << x.t;
+}
+
+// A sentence faster than the grid (ROT at 20 Hz on a 10 Hz grid) with sentences lost: each
+// sample has the latest ROT at or before its look time, never a gap.
+TEST(Assembler, ASentenceFasterThanTheGridGivesItsLatestValueOverALoss) {
   SampleAssembler a(AssemblerConfig{});
   std::vector<double> times;
-  for (int i = 0; i < 200; ++i) {
-    times.push_back(0.1 * i + 0.0015 * std::sin(1.7 * i));  // +-1.5 ms around the grid
-    // RSA on the grid (every grid time has a sample); the inputs in time order
-    const bool rot_first = times.back() <= 0.1 * i;
-    if (!rot_first) {
-      ASSERT_TRUE(a.add(0.1 * i, rsa(1.0)));
-    }
-    ASSERT_TRUE(a.add(times.back(), rot(i)));
-    if (rot_first) {
-      ASSERT_TRUE(a.add(0.1 * i, rsa(1.0)));
-    }
+  for (int i = 0; i < 400; ++i) {
+    if (i % 10 == 3 || i % 10 == 4) continue;  // 20 % lost, two in a row
+    times.push_back(0.05 * i + 0.013);
+    a.add(times.back(), rot(i));
   }
-  a.advance(0.1 * 199);
-  const auto s = a.take();
-  ASSERT_EQ(s.size(), 200u);
-  const auto latest_at = [&](double t) {
+  a.advance(19.9);
+  EXPECT_NEAR(a.learned_period("ROT"), 0.05, 1e-9);
+  for (const auto& x : a.take()) {
+    ASSERT_FALSE(std::isnan(x.r)) << x.t;
     int latest = -1;
-    for (int i = 0; i < 200; ++i) {
-      if (times[i] <= t) latest = i;
+    for (double t : times) {
+      if (t <= x.t + 0.05) latest = static_cast<int>(std::lround((t - 0.013) / 0.05));
     }
-    return latest;
-  };
-  // Before the period is known, the zero-order hold: every sample has the latest value.
-  const int k0 = SampleAssembler::kMinIntervals + 2;
-  ASSERT_FALSE(std::isnan(s[k0 - 1].r));
-  int used = latest_at(s[k0 - 1].t);
-  int gaps = 0;
-  for (int k = k0; k < 200; ++k) {
-    const int latest = latest_at(s[k].t);
-    if (latest == used) {
-      ++gaps;
-      EXPECT_TRUE(std::isnan(s[k].r)) << s[k].t;
-    } else {
-      EXPECT_NEAR(s[k].r, yaw_rate_from_rot(latest), 1e-15) << s[k].t;
-      used = latest;
+    EXPECT_NEAR(x.r, yaw_rate_from_rot(latest), 1e-15) << x.t;
+  }
+}
+
+// A sentence that changes its rate (10 Hz, then 1 Hz from 5 s): learned again after three
+// intervals off the old period, then held over the grid times between arrivals.
+TEST(Assembler, ANewRateIsLearnedAgain) {
+  AssemblerConfig c;
+  c.max_age_s = 3.0;
+  SampleAssembler a(c);
+  for (int i = 0; i <= 50; ++i) a.add(0.1 * i, rot(1.0));
+  for (int i = 6; i <= 20; ++i) a.add(1.0 * i, rot(2.0));
+  a.advance(20.0);
+  EXPECT_NEAR(a.learned_period("ROT"), 1.0, 1e-9);
+  for (const auto& x : a.take()) {
+    if (x.t > 11.0) {
+      EXPECT_FALSE(std::isnan(x.r)) << x.t;  // 4 intervals of 1 s by 10 s
     }
   }
-  EXPECT_GT(gaps, 20);  // the pattern has them (a ROT after the grid time that follows one before)
+}
+
+// The surge speed: where the water speed is withheld as a repetition (its VBW lost), u is
+// missing, not the ground speed for one sample.
+TEST(Assembler, AWithheldWaterSpeedIsNotReplacedByTheGroundSpeed) {
+  SampleAssembler a(AssemblerConfig{});
+  for (int i = 0; i <= 30; ++i) {
+    if (i != 20) a.add(0.1 * i, vbw(8.0, 0.0));
+    a.add(0.1 * i, vtg(10.0));
+  }
+  a.advance(3.0);
+  for (const auto& x : a.take()) {
+    if (std::lround(x.t / 0.1) == 20) {
+      EXPECT_TRUE(std::isnan(x.u)) << x.t;
+    } else {
+      EXPECT_NEAR(x.u, speed_from_knots(8.0), 1e-12) << x.t;
+    }
+  }
 }
 
 // A sentence slower than the grid (VBW at 1 Hz on a 10 Hz grid) is held over the grid times
@@ -253,7 +334,9 @@ TEST(Assembler, AnIrregularSentenceIsHeldUpToMaxAge) {
 }
 
 TEST(Assembler, StatusVInvalidatesWithoutRefreshingTheAge) {
-  SampleAssembler a(AssemblerConfig{});
+  AssemblerConfig c;
+  c.hold_until_due = false;  // the look time is the grid time
+  SampleAssembler a(c);
   a.add(0.0, rot(5.0));
   a.add(0.25, rot(6.0, Status::kInvalid));
   a.advance(0.3);

@@ -16,23 +16,31 @@
 // until the next sentence of its kind is due (below), never longer than max_age_s.
 //
 // Output: a sample at every grid time g = k / rate_hz (k integer, so several assemblers share
-// the same grid), holding each quantity's latest valid value measured at or before g, and
-// NaN where that value is older than max_age_s, or none was received, or (hold_until_due) its
-// successor is overdue (NaN is how usvfdi::Sample marks a missing value; u NaN = not
-// measured). A grid time where every quantity is missing is not emitted (no flood of empty
-// samples after a long silence). Samples are emitted when an input later than g arrives, or
-// by advance(t) for g <= t.
+// the same grid), holding each quantity's latest valid value measured at or before g's look
+// time g + L, and NaN where that value is older than max_age_s (g - tau), or none was
+// received, or (hold_until_due) it is not given again (below). NaN is how usvfdi::Sample
+// marks a missing value; u NaN = not measured. A grid time where every quantity is missing is
+// not emitted (no flood of empty samples after a long silence). Samples are emitted when an
+// input later than g + L arrives, or by advance(t) for g <= t. L is 0 with hold_until_due
+// false (the latest value at or before g), else half a grid period: each value goes to the
+// grid time nearest its measurement, so that sentences sent at the grid rate, whose times lie
+// on the grid (the time base starts at the first one), do not fall before or after it by
+// their jitter. The ages (g - tau) may then be negative, down to -L.
 //
 // Held until due (hold_until_due, the default): each sentence's period P is learned as the
-// median of its last intervals (at least kMinIntervals, positive ones only: lines of one
-// datagram share a time), with a tolerance tol = max(4.5 MAD, 2 ms) for the jitter; a
-// sentence whose intervals scatter by more than P / 4 (MAD) is not periodic and is held up
-// to max_age_s. A value measured at tau is then missing at g when its successor is overdue,
-// g >= tau + P + tol, or when it is due about now, g >= tau + P - tol, and the value was
-// already in an earlier sample: a lost sentence is a gap in that quantity, not the previous
+// median of its last 15 intervals (once it has kMinIntervals; an interval under 2 ms is
+// another line of the same datagram or a copy, not an arrival), with a tolerance
+// tol = max(4.5 MAD, 2 ms) for the jitter. A sentence is not periodic, and is held up to
+// max_age_s, when its intervals scatter by more than P / 4 (MAD) or fewer than 80 % of them
+// are whole multiples of P (within max(tol, P / 8): a lost sentence makes an interval of 2 P;
+// two senders of one sentence make short and long intervals that are neither). Three
+// intervals in a row off P +- tol restart the learning from them (a new rate). A value
+// measured at tau that is already in a sample is not given again once its successor is due,
+// g + L >= tau + P - tol: a lost or late sentence is a gap in that quantity, not the previous
 // value again (a repeated value is a step of the signal's derivative, which the observers
-// read as a fault). Sentences slower than the grid (VBW at 1 Hz on a 10 Hz grid) are held
-// over the grid times between them as before.
+// read as a fault). A value not yet in a sample is given however late its successor. So
+// sentences faster than the grid give their latest value, and those slower than the grid
+// (VBW at 1 Hz on a 10 Hz grid) are held over the grid times between their arrivals.
 //
 // stale(t) names the sentences that have stopped: a quantity without a valid value for more
 // than max_age_s (or never received, max_age_s after the first input), with its age. (A
@@ -52,8 +60,9 @@ namespace usvfdi::nmea {
 struct AssemblerConfig {
   double rate_hz = 10.0;   ///< output rate (> 0)
   double max_age_s = 1.0;  ///< a value older than this is missing in the sample (> 0)
-  /// A value is missing once its sentence's successor is due and has not come (the period
-  /// learned from the sentence's arrivals); false: held up to max_age_s (zero-order hold).
+  /// Each value to the grid time nearest it, and not given again once its sentence's next is
+  /// due (the period learned from the sentence's arrivals; see above); false: the latest value
+  /// at or before the grid time, held up to max_age_s (zero-order hold).
   bool hold_until_due = true;
   RudderSign rudder_sign = RudderSign::kPositiveToPort;  ///< the vessel model's (b2 < 0)
 };
@@ -145,6 +154,7 @@ class SampleAssembler {
     int next = 0;   ///< where the next interval goes
     double period = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not learned
     double tolerance = 0.0;
+    int off_period = 0;  ///< intervals in a row off period +- tolerance
     void arrive(double t);
   };
   enum Feed { kRot = 0, kRsa, kVbw, kVtg, kFeeds };
@@ -166,6 +176,7 @@ class SampleAssembler {
 
   AssemblerConfig config_;
   double period_;
+  double look_ahead_;  ///< hold_until_due: half a grid period, else 0
   Held held_[kSlots];
   Arrivals arrivals_[kFeeds];
   double first_input_ = std::numeric_limits<double>::quiet_NaN();
