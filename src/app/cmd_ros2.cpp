@@ -87,8 +87,9 @@ struct Input {
   double received = 0.0;  ///< DDS reception timestamp (this host's clock) [s]
 };
 
-/// The listener of the three ROS 2 readers: it only copies samples, in the order they arrive,
-/// into a bounded queue (full: the oldest is dropped and counted).
+/// The listener of the ROS 2 readers (yaw, sway, rudder, and the surge speed's own topic): it only
+/// copies samples, in the order they arrive, into a bounded queue (full: the oldest is dropped and
+/// counted).
 class InputQueue : public fdds::DataReaderListener {
  public:
   /// surge: the sway message's linear.x is the surge speed (--surge-from-sway); surge_odometry:
@@ -634,6 +635,18 @@ int run_ros2(Ros2Args& a) {
       return kExitUsage;
     }
   }
+  if (!a.surge_topic.empty()) {
+    const std::string surge = ros2::dds_topic_of(a.surge_topic);
+    if (surge == ros2::dds_topic_of(a.sway_topic)) {
+      spdlog::error("--surge-topic {} is the sway topic: use --surge-from-sway", a.surge_topic);
+      return kExitUsage;
+    }
+    if (surge == ros2::dds_topic_of(a.imu_topic) || surge == ros2::dds_topic_of(a.rudder_topic)) {
+      spdlog::error("--surge-topic {} is also the Imu or rudder topic (another type)",
+                    a.surge_topic);
+      return kExitUsage;
+    }
+  }
   dds::DdsConfig cfg;
   try {
     cfg = make_dds_config(a.dds);
@@ -744,7 +757,8 @@ void register_ros2_command(CommandRegistry& registry) {
                   "--surge-topic's type: twist (geometry_msgs/TwistStamped) or odometry "
                   "(nav_msgs/Odometry)")
       ->check(CLI::IsMember({"twist", "odometry"}))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs("--surge-topic");
 }
 
 }  // namespace usvfdi::app

@@ -477,8 +477,19 @@ void FdiService::stop() {
        {listener_->ins_, listener_->rudder_, listener_->speed_, listener_->ack_, event_watch_}) {
     if (r != nullptr) r->set_listener(nullptr);
   }
-  if (nmea_) nmea_->stop();  // no more samples; its status note stays readable
-  pipeline_->stop();         // drains the queues; the publisher thread writes the last events
+  if (nmea_) {
+    nmea_->stop();  // no more samples; its status note stays readable
+    if (log_) {
+      const nmea_udp::DecoderStats st = nmea_->stats();
+      const auto u = [](std::uint64_t x) { return std::to_string(x); };
+      log_(1, "NMEA input stopped: " + u(st.datagrams) + " datagrams, " + u(st.lines) +
+                  " lines: " + u(st.used) + " used (" + u(st.not_valid) + " not valid), " +
+                  u(st.ignored) + " ignored, " + u(st.bad) + " refused" +
+                  (st.bad > 0 ? " (" + st.describe() + ")" : std::string()) + "; " +
+                  u(st.lost_lines) + " lines lost");
+    }
+  }
+  pipeline_->stop();  // drains the queues; the publisher thread writes the last events
   if (log_ && uplink_.offered() > 0) {
     const auto n = [this](UplinkReason r) {
       return static_cast<unsigned long long>(uplink_.sent(r));

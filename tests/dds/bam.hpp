@@ -180,7 +180,8 @@ inline std::string acn_datagram(long id, char command, const std::string& m = "U
   return nmea::format_iec450_datagram(tag, {nmea::format_acn(a).value()}).value();
 }
 
-constexpr long kAccel = 3001, kGyro = 3002;  ///< `usv-fdi bridge`'s default alert identifiers
+/// `usv-fdi bridge`'s default alert identifiers.
+constexpr long kAccel = 3001, kGyro = 3002, kUnknown = 3003;
 constexpr auto V = nmea::AlertState::kActiveUnacknowledged;
 constexpr auto A = nmea::AlertState::kActiveAcknowledged;
 constexpr auto U = nmea::AlertState::kRectifiedUnacknowledged;

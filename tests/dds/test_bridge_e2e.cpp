@@ -57,7 +57,7 @@ TEST(BridgeEndToEnd, PaperScenarioAlertsFollowTheLifecycleAndAcnAcknowledges) {
       << bam.dump() << f.log("bridge") << f.log("svc");
   EXPECT_TRUE(bam.saw(kGyro, V)) << bam.dump();
   EXPECT_TRUE(bam.saw(kAccel, V)) << bam.dump();
-  EXPECT_FALSE(bam.saw(3003, V)) << "no unknown-sensor alert\n" << bam.dump();
+  EXPECT_FALSE(bam.saw(kUnknown, V)) << "no unknown-sensor alert\n" << bam.dump();
   EXPECT_TRUE(bam.bad.empty()) << bam.dump();
   // The ALC lists both alerts with their revisions in force.
   const int alc_before = static_cast<int>(bam.alc.size());

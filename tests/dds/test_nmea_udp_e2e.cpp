@@ -65,6 +65,23 @@ std::string dump(const std::vector<MonitorEvent>& all) {
   return s;
 }
 
+/// The noise-free paper scenario (Otter, 10 Hz) as the simulator's NMEA log: its lines (ROT,
+/// RSA, VBW per sample, each after its TAG block), each ending in CR LF.
+void paper_nmea_lines(Fleet& f, std::vector<std::string>* lines) {
+  const std::string log_file = f.dir() + "paper.nmea";
+  ASSERT_EQ(f.run_to_end("simlog",
+                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
+                          "--noise-scale", "0", "--nmea", "--output", log_file},
+                         seconds(60), nullptr, false),
+            0);
+  std::ifstream in(log_file);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty()) lines->push_back(line + "\r\n");
+  }
+  ASSERT_EQ(lines->size(), 3u * 1001u);
+}
+
 /// The first event of `sensor` in state `state` stamped in [t0, t1), or nullptr.
 const MonitorEvent* first(const std::vector<MonitorEvent>& all, const std::string& sensor,
                           const std::string& state, double t0, double t1) {
@@ -256,21 +273,8 @@ TEST(NmeaUdpEndToEnd, LostDatagramsAreCountedAndInventNoFault) {
   Fleet f;
   const unsigned m = 257300003;
   const unsigned port = test_port(2);
-  const std::string log_file = f.dir() + "paper.nmea";
-  ASSERT_EQ(f.run_to_end("simlog",
-                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
-                          "--noise-scale", "0", "--nmea", "--output", log_file},
-                         seconds(60), nullptr, false),
-            0);
   std::vector<std::string> lines;
-  {
-    std::ifstream in(log_file);
-    for (std::string line; std::getline(in, line);) {
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      if (!line.empty()) lines.push_back(line + "\r\n");
-    }
-  }
-  ASSERT_EQ(lines.size(), 3u * 1001u);
+  ASSERT_NO_FATAL_FAILURE(paper_nmea_lines(f, &lines));
   // (the default nmea.max_age, 1 s: a value is held until its next sentence is due)
   const std::string cfg = f.write_service_config("svc", m, nmea_service(port, {}, ""));
   ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
@@ -335,21 +339,8 @@ TEST(NmeaUdpEndToEnd, FromTheNmeaNetworkToTheBridgeAlertsGarbageIsCountedAndNeve
   const unsigned m = 257300004;
   const std::string ms = std::to_string(m);
   const unsigned port = test_port(3);
-  const std::string log_file = f.dir() + "paper.nmea";
-  ASSERT_EQ(f.run_to_end("simlog",
-                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
-                          "--noise-scale", "0", "--nmea", "--output", log_file},
-                         seconds(60), nullptr, false),
-            0);
   std::vector<std::string> lines;
-  {
-    std::ifstream in(log_file);
-    for (std::string line; std::getline(in, line);) {
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      if (!line.empty()) lines.push_back(line + "\r\n");
-    }
-  }
-  ASSERT_EQ(lines.size(), 3u * 1001u);
+  ASSERT_NO_FATAL_FAILURE(paper_nmea_lines(f, &lines));
   // The stream pauses while the gyro fault is acknowledged: the wall-clock INS watchdog waits
   // longer than that. Statuses at least every 0.5 s: the bridge calls a vessel silent after 2 s.
   f.start_service(
@@ -380,7 +371,7 @@ TEST(NmeaUdpEndToEnd, FromTheNmeaNetworkToTheBridgeAlertsGarbageIsCountedAndNeve
   std::string bad_checksum = nmea::test::with_checksum("HEROT,12.5,A");
   bad_checksum.back() = bad_checksum.back() == '0' ? '1' : '0';
   bad_checksum += "\r\n";
-  unsigned garbage_lines = 0;
+  unsigned garbage_lines = 0, garbage_datagrams = 0;
   const auto send = [&](std::size_t from, std::size_t to) {
     const auto t0 = std::chrono::steady_clock::now();
     for (std::size_t k = from; k < to; ++k) {
@@ -395,6 +386,7 @@ TEST(NmeaUdpEndToEnd, FromTheNmeaNetworkToTheBridgeAlertsGarbageIsCountedAndNeve
       if (k % 40 == 11) {
         ASSERT_TRUE(tx.send(std::string("RrUdP\0garbage\r\n", 15)));
         ASSERT_TRUE(tx.send("\x01\x02\x03\xff\r\n"));
+        garbage_datagrams += 2;
       }
     }
   };
@@ -431,18 +423,27 @@ TEST(NmeaUdpEndToEnd, FromTheNmeaNetworkToTheBridgeAlertsGarbageIsCountedAndNeve
       << bam.dump() << f.log("bridge");
   // AND the garbage acted on nothing: one alert per sensor's fault, no unknown-sensor alert,
   // each raised once
-  EXPECT_FALSE(bam.saw(3003, bam_side::V)) << bam.dump();
+  EXPECT_FALSE(bam.saw(bam_side::kUnknown, bam_side::V)) << bam.dump();
   std::set<std::pair<long, int>> distinct;
   for (const auto& a : bam.alf) {
     if (a.state == bam_side::V) distinct.insert({a.alert.id, a.revision});
   }
   EXPECT_EQ(distinct.size(), 2u) << bam.dump();
-  // AND it was counted by reason and logged
-  EXPECT_GT(garbage_lines, 0u);
+  // AND every garbage line and datagram was refused, counted by reason (the sidecar's summary
+  // when it stops), and the voyage's lines all used
   EXPECT_TRUE(f.wait_for_log("svc", "line(s) refused", seconds(5))) << f.log("svc");
+  f.process("svc").signal(SIGTERM);
+  ASSERT_TRUE(f.process("svc").wait_exit(seconds(10)).has_value());
   const std::string svc = f.log("svc");
-  EXPECT_NE(svc.find("checksum"), std::string::npos) << svc;
-  EXPECT_NE(svc.find("out of range"), std::string::npos) << svc;
+  const auto at = svc.find("NMEA input stopped: ");
+  ASSERT_NE(at, std::string::npos) << svc;
+  const std::string summary = svc.substr(at, svc.find('\n', at) - at);
+  EXPECT_NE(summary.find(" " + std::to_string(3 * 1001) + " used "), std::string::npos) << summary;
+  EXPECT_NE(summary.find(" " + std::to_string(garbage_lines + garbage_datagrams) + " refused ("),
+            std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("checksum mismatch"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("out of range"), std::string::npos) << summary;
 }
 
 }  // namespace
