@@ -2,15 +2,17 @@
 # What lost NMEA datagrams do to the faults raised, for both ways of holding a value on the
 # sample grid (usv-fdi replay --nmea-hold due | max-age; docs/integration.md, "Lost datagrams").
 #
-#   scripts/bench-nmea-loss.sh [--every N] [--jitter MS] [--seeds "1 2 3 4"] [--noise "0 0.2 1"]
-#                              [--build DIR]
+#   scripts/bench-nmea-loss.sh [--every N] [--jitter MS] [--rsa-phase MS] [--seeds "1 2 3 4"]
+#                              [--noise "0 0.2 1"] [--build DIR]
 #
 # For each vessel (otter, mariner), scenario (faults, healthy), seed and noise scale, the
 # simulator writes the voyage as an NMEA log (ROT, RSA, VBW per 10 Hz sample, TAG times); a copy
 # loses every N-th sample's datagram (its three lines). With --jitter, every line's TAG time
 # c: of both logs moves by a uniform random -MS..+MS ms (seeded), as a sender's clock and
-# scheduler would put it: the times then straddle the sample grid. Both logs are replayed with
-# each hold.
+# scheduler would put it: the times then straddle the sample grid. With --rsa-phase, the RSA
+# lines (the rudder: another sender, the steering gear) are sent MS ms later than the INS's
+# ROT and VBW (and given that TAG time: the rudder angle then belongs to that later instant,
+# a lag of MS ms the engine sees as such). Both logs are replayed with each hold.
 # A raised event of the lossy replay with no raised event of the same sensor within 5 s in the
 # lossless replay (same hold) is "invented"; one of the lossless replay with none in the lossy
 # replay is "lost". Prints one table row per noise scale and hold (sums over the runs).
@@ -18,6 +20,7 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 every=37
 jitter=0
+rsa_phase=0
 seeds="1 2 3 4"
 noise="0 0.2 1"
 build="$here/build"
@@ -25,6 +28,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --every) every="$2"; shift 2 ;;
     --jitter) jitter="$2"; shift 2 ;;
+    --rsa-phase) rsa_phase="$2"; shift 2 ;;
     --seeds) seeds="$2"; shift 2 ;;
     --noise) noise="$2"; shift 2 ;;
     --build) build="$2"; shift 2 ;;
@@ -51,9 +55,10 @@ for ns in $noise; do
         f="$work/ns$ns-$v-$sc-$seed"
         "$exe" sim --vessel "$v" --scenario "$sc" --rate 10 --seed "$seed" --noise-scale "$ns" \
           --nmea --output "$f.nmea" 2>/dev/null
-        python3 - "$f.nmea" "$every" "$jitter" "$seed" <<'EOF'
+        python3 - "$f.nmea" "$every" "$jitter" "$seed" "$rsa_phase" <<'EOF'
 import random, re, sys
 path, every, jitter_ms, seed = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+rsa_phase = int(sys.argv[5])
 rng = random.Random(seed)
 
 def in_ms(c):
@@ -63,9 +68,10 @@ def in_ms(c):
 def jittered(line):
     # \s:..,c:MS*hh\$... : move c: and recompute the TAG block's checksum
     m = re.match(r"\\([^*]*)\*[0-9A-Fa-f]{2}\\(.*)", line)
-    if not m or jitter_ms == 0:
+    if not m or (jitter_ms == 0 and rsa_phase == 0):
         return line
-    body = re.sub(r"c:(\d+)", lambda c: "c:%d" % (in_ms(int(c.group(1))) + round(rng.uniform(-jitter_ms, jitter_ms))), m.group(1))
+    shift = rsa_phase if "RSA," in m.group(2) else 0
+    body = re.sub(r"c:(\d+)", lambda c: "c:%d" % (in_ms(int(c.group(1))) + shift + round(rng.uniform(-jitter_ms, jitter_ms))), m.group(1))
     x = 0
     for ch in body:
         x ^= ord(ch)
@@ -96,10 +102,10 @@ EOF
   done
 done
 
-python3 - "$work" "$every" "$noise" "$jitter" <<'EOF'
+python3 - "$work" "$every" "$noise" "$jitter" "$rsa_phase" <<'EOF'
 import glob, json, os, sys
 
-work, every, noises, jitter = sys.argv[1], sys.argv[2], sys.argv[3].split(), sys.argv[4]
+work, every, noises, jitter, rsa_phase = sys.argv[1], sys.argv[2], sys.argv[3].split(), sys.argv[4], sys.argv[5]
 
 def raised(path):
     out = []
@@ -113,7 +119,7 @@ def raised(path):
 def unmatched(a, b, tol=5.0):
     return [x for x in a if not any(x[0] == y[0] and abs(x[1] - y[1]) <= tol for y in b)]
 
-print(f"every {every}th datagram lost, TAG times +-{jitter} ms; raised events summed over the runs\n")
+print(f"every {every}th datagram lost, TAG times +-{jitter} ms, RSA {rsa_phase} ms later; raised events summed over the runs\n")
 print("| noise scale | hold | runs | raised, lossless | raised, lossy | invented | lost |")
 print("|---|---|---|---|---|---|---|")
 for ns in noises:

@@ -27,10 +27,10 @@ namespace {
 struct ReplayArgs {
   std::string config;
   std::string input;
-  std::string output;               ///< empty or "-": stdout
-  std::string format = "auto";      ///< auto (by the extension), csv or nmea
-  std::optional<double> nmea_rate;  ///< NMEA: sentence cycle and sample rate [Hz]
-  std::string nmea_hold = "due";    ///< NMEA: due (until the next is due) or max-age
+  std::string output;                 ///< empty or "-": stdout
+  std::string format = "auto";        ///< auto (by the extension), csv or nmea
+  std::optional<double> nmea_rate;    ///< NMEA: sentence cycle and sample rate [Hz]
+  std::string nmea_hold = "max-age";  ///< NMEA: max-age (zero-order hold) or due
   io::ReplayOptions options;
 };
 
@@ -230,10 +230,10 @@ void register_replay_command(CommandRegistry& registry) {
                   "sentence")
       ->check(CLI::PositiveNumber);
   sub->add_option("--nmea-hold", args->nmea_hold,
-                  "NMEA: how values are put on the sample grid: due (each at the grid time "
-                  "nearest it, never twice once its sentence's next is due, the period learned "
-                  "from the log: a lost sentence is a gap) or max-age (the latest at or before "
-                  "the grid time, held up to the max age: zero-order hold)")
+                  "NMEA: how values are put on the sample grid: max-age (the latest at or before "
+                  "the grid time, held up to the max age: zero-order hold) or due (each at the "
+                  "grid time nearest it, never twice once its sentence's next is overdue, the "
+                  "period learned from the log: a lost sentence is a gap)")
       ->check(CLI::IsMember({"due", "max-age"}))
       ->capture_default_str();
   sub->add_option("--output", args->output, "output JSON Lines file (default: stdout)");

@@ -28,14 +28,14 @@ double median_of(double* x, int n) {
 }
 }  // namespace
 
-void SampleAssembler::Arrivals::arrive(double t) {
+bool SampleAssembler::Arrivals::arrive(double t) {
   if (std::isnan(last)) {
     last = t;
-    return;
+    return true;
   }
   const double dt = t - last;
   // Another line of the same datagram, or a copy of the sentence: the same arrival.
-  if (dt < kMinTolerance) return;
+  if (dt < kMinTolerance) return false;
   last = t;
   // A new rate: the last few intervals all off the learned period; learn again from them.
   off_period = !std::isnan(period) && std::abs(dt - period) > tolerance ? off_period + 1 : 0;
@@ -53,22 +53,23 @@ void SampleAssembler::Arrivals::arrive(double t) {
     off_period = 0;
   }
   period = kNaN;
-  if (count < kMinIntervals) return;
+  if (count < kMinIntervals) return true;
   double x[kKeptIntervals];
   std::copy(intervals, intervals + count, x);
   const double p = median_of(x, count);
   for (int i = 0; i < count; ++i) x[i] = std::abs(x[i] - p);
   const double mad = median_of(x, count);
-  if (mad > kMaxScatter * p) return;  // not periodic: held up to max_age_s
+  if (mad > kMaxScatter * p) return true;  // not periodic: held up to max_age_s
   const double tol = std::max(kMadsOfJitter * mad, kMinTolerance);
   int on_period = 0;
   for (int i = 0; i < count; ++i) {
     const double k = std::round(intervals[i] / p);
     on_period += k >= 1.0 && std::abs(intervals[i] - k * p) <= std::max(tol, p / 8.0);
   }
-  if (on_period < kMinOnPeriod * count) return;
+  if (on_period < kMinOnPeriod * count) return true;
   period = p;
   tolerance = tol;
+  return true;
 }
 
 SampleAssembler::Feed SampleAssembler::feed_of(Slot slot) {
@@ -132,14 +133,14 @@ void SampleAssembler::set(Slot slot, double t, bool valid, double value) {
 
 bool SampleAssembler::add(double t, const Rot& rot) {
   if (!accept_time(t)) return false;
-  arrivals_[kRot].arrive(t);
+  if (!arrivals_[kRot].arrive(t) && config_.hold_until_due) return true;  // a copy
   set(kR, t, rot.valid(), rot.valid() ? yaw_rate_from_rot(*rot.rate_deg_per_min) : kNaN);
   return true;
 }
 
 bool SampleAssembler::add(double t, const Rsa& rsa) {
   if (!accept_time(t)) return false;
-  arrivals_[kRsa].arrive(t);
+  if (!arrivals_[kRsa].arrive(t) && config_.hold_until_due) return true;  // a copy
   if (rsa.starboard_valid()) {
     set(kDelta, t, true, delta_from_rsa(*rsa.starboard_deg, config_.rudder_sign));
   } else if (rsa.port_valid()) {
@@ -152,7 +153,7 @@ bool SampleAssembler::add(double t, const Rsa& rsa) {
 
 bool SampleAssembler::add(double t, const Vbw& vbw) {
   if (!accept_time(t)) return false;
-  arrivals_[kVbw].arrive(t);
+  if (!arrivals_[kVbw].arrive(t) && config_.hold_until_due) return true;  // a copy
   const bool water = vbw.water_valid();
   set(kV, t, water && vbw.water_transverse_kn,
       water && vbw.water_transverse_kn ? speed_from_knots(*vbw.water_transverse_kn) : kNaN);
@@ -163,7 +164,7 @@ bool SampleAssembler::add(double t, const Vbw& vbw) {
 
 bool SampleAssembler::add(double t, const Vtg& vtg) {
   if (!accept_time(t)) return false;
-  arrivals_[kVtg].arrive(t);
+  if (!arrivals_[kVtg].arrive(t) && config_.hold_until_due) return true;  // a copy
   const bool ok = vtg.valid() && vtg.speed_kn;
   set(kUGround, t, ok, ok ? speed_from_knots(*vtg.speed_kn) : kNaN);
   return true;
@@ -213,11 +214,12 @@ double SampleAssembler::at(Slot slot, double g, double* age) {
   *age = kNaN;
   if (std::isnan(h.value) || !(g - h.time <= config_.max_age_s)) return kNaN;
   const Arrivals& a = arrivals_[feed_of(slot)];
-  // Already in a sample, and its successor due by g's look-ahead time: the successor is lost
-  // or late, and the value is not given again. (One not yet used is given, however late its
-  // successor: it is no repetition.)
+  // Already in a sample, and its successor overdue (beyond the jitter, at most half the
+  // look-ahead) by g's look-ahead time: the successor is lost or late, and the value is not
+  // given again. (One not yet used is
+  // given, however late its successor: it is no repetition.)
   if (config_.hold_until_due && !std::isnan(a.period) && h.used &&
-      g + look_ahead_ >= h.time + a.period - a.tolerance) {
+      g + look_ahead_ >= h.time + a.period + std::min(a.tolerance, 0.5 * look_ahead_)) {
     return kNaN;
   }
   h.used = true;

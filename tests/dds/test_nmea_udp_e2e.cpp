@@ -275,8 +275,10 @@ TEST(NmeaUdpEndToEnd, LostDatagramsAreCountedAndInventNoFault) {
   const unsigned port = test_port(2);
   std::vector<std::string> lines;
   ASSERT_NO_FATAL_FAILURE(paper_nmea_lines(f, &lines));
-  // (the default nmea.max_age, 1 s: a value is held until its next sentence is due)
-  const std::string cfg = f.write_service_config("svc", m, nmea_service(port, {}, ""));
+  // (the default nmea.max_age, 1 s, with hold_until_due: a value is not given again once its
+  // next sentence is due)
+  const std::string cfg =
+      f.write_service_config("svc", m, nmea_service(port, {"  hold_until_due: true"}, ""));
   ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
   f.start_service("svc", cfg, 1);
   ASSERT_TRUE(f.wait_for_log("svc", "NMEA input: multicast group", seconds(10))) << f.log("svc");

@@ -144,10 +144,10 @@ TEST_F(NmeaReplay, LostSentencesAreGapsNotTheOldValuesAgain) {
     out << lossy;
   }
   // WHEN it is replayed with each way of holding a value on the grid
-  const auto due = replay("config/scenarios/paper.yaml", path("lossy.nmea"));
+  const auto due = replay("config/scenarios/paper.yaml", path("lossy.nmea"), "--nmea-hold due");
   const auto held =
       replay("config/scenarios/paper.yaml", path("lossy.nmea"), "--nmea-hold max-age");
-  // THEN held until due (the default), the lost samples are gaps: the gyro fault, then the
+  // THEN held until due, the lost samples are gaps: the gyro fault, then the
   // accelerometer fault, at their onsets, nothing else
   const auto d = raised(due);
   ASSERT_EQ(d.size(), 2u);
@@ -156,8 +156,8 @@ TEST_F(NmeaReplay, LostSentencesAreGapsNotTheOldValuesAgain) {
   EXPECT_EQ(d[1].sensor, "accelerometer");
   EXPECT_NEAR(d[1].detection_time, 60.0, 1.0);
   EXPECT_EQ(due.back().at("samples").num, 1001.0 - 27.0);  // 27 grid times without a sample
-  // AND held up to the max age (the zero-order hold), the old values again at those grid
-  // times: every sample is there, and the voyage's faults are not what it raises
+  // AND held up to the max age (the zero-order hold, the default), the old values again at those
+  // grid times: every sample is there, and the voyage's faults are not what it raises
   const auto h = raised(held);
   EXPECT_EQ(held.back().at("samples").num, 1001.0);
   EXPECT_FALSE(h.size() == 2u && h[0].sensor == "gyro" && h[0].detection_time < 21.0 &&

@@ -43,6 +43,13 @@ Vtg vtg(double kn, PositioningMode mode = PositioningMode::kAutonomous) {
   return x;
 }
 
+/// The configuration with hold_until_due (include/usv_fdi/nmea/assembler.hpp).
+AssemblerConfig until_due() {
+  AssemblerConfig c;
+  c.hold_until_due = true;
+  return c;
+}
+
 TEST(Assembler, UnitsAndSignsOfTheShippedVessels) {
   SampleAssembler a(AssemblerConfig{});     // 10 Hz, 1 s, delta > 0 to port (b2 < 0)
   ASSERT_TRUE(a.add(0.0, rot(60.0)));       // 60 deg/min, bow to starboard
@@ -225,65 +232,100 @@ TEST(Assembler, JitterAroundTheGridGoesToTheNearestGridTime) {
 // clock): the intervals alternate short and long, no period is learned, and the values are
 // held up to max_age_s as before. A copy within 2 ms is the same arrival.
 TEST(Assembler, TwoSendersOfOneSentenceTeachNoPeriod) {
-  SampleAssembler a(AssemblerConfig{});
-  SampleAssembler copies(AssemblerConfig{});
+  SampleAssembler a(until_due());
+  SampleAssembler copies(until_due());
   for (int i = 0; i < 100; ++i) {
+    a.add(0.1 * i, rsa(1.0));  // on the grid: every grid time has a sample
     a.add(0.1 * i + 0.01, rot(i));
     a.add(0.1 * i + 0.04, rot(i + 0.5));  // the second talker, 30 ms later
+    copies.add(0.1 * i, rsa(1.0));
     copies.add(0.1 * i + 0.01, rot(i));
-    copies.add(0.1 * i + 0.0105, rot(i));  // the same datagram again, 0.5 ms later
+    copies.add(0.1 * i + 0.0105, rot(i + 0.25));  // a copy 0.5 ms later (not read)
   }
-  a.advance(9.9);
-  copies.advance(9.9);
+  a.advance(0.1 * 99);
+  copies.advance(0.1 * 99);
   EXPECT_TRUE(std::isnan(a.learned_period("ROT")));
-  for (const auto& x : a.take()) EXPECT_FALSE(std::isnan(x.r)) << x.t;
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 100u);
+  for (const auto& x : s) EXPECT_FALSE(std::isnan(x.r)) << x.t;
   EXPECT_NEAR(copies.learned_period("ROT"), 0.1, 1e-9);
-  for (const auto& x : copies.take()) EXPECT_FALSE(std::isnan(x.r)) << x.t;
+  const auto c = copies.take();
+  ASSERT_EQ(c.size(), 100u);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_NEAR(c[i].r, yaw_rate_from_rot(static_cast<double>(i)), 1e-15) << c[i].t;
+  }
 }
 
 // A sentence faster than the grid (ROT at 20 Hz on a 10 Hz grid) with sentences lost: each
 // sample has the latest ROT at or before its look time, never a gap.
 TEST(Assembler, ASentenceFasterThanTheGridGivesItsLatestValueOverALoss) {
-  SampleAssembler a(AssemblerConfig{});
+  SampleAssembler a(until_due());
   std::vector<double> times;
   for (int i = 0; i < 400; ++i) {
-    if (i % 10 == 3 || i % 10 == 4) continue;  // 20 % lost, two in a row
+    if (i % 2 == 0) a.add(0.05 * i, rsa(1.0));  // on the grid: every grid time has a sample
+    // Lost: every 10th ROT from the 2nd (the one nearest grid time x.1 or x.6: the one before
+    // it, not yet in a sample, stands in) and two in a row before grid times x.3 and x.8 (no ROT
+    // since the previous sample's: a gap).
+    if (i % 10 == 2 || i % 10 == 5 || i % 10 == 6) continue;
     times.push_back(0.05 * i + 0.013);
     a.add(times.back(), rot(i));
   }
-  a.advance(19.9);
+  a.advance(0.1 * 199);
   EXPECT_NEAR(a.learned_period("ROT"), 0.05, 1e-9);
-  for (const auto& x : a.take()) {
-    ASSERT_FALSE(std::isnan(x.r)) << x.t;
+  const auto s = a.take();
+  ASSERT_EQ(s.size(), 200u);
+  // Each sample has the latest ROT at or before its look time x.t + 0.05, unless the previous
+  // sample had that one: then a gap (from 1 s on: the period is learned from 4 intervals).
+  int used = -1, gaps = 0, stand_ins = 0;
+  for (const auto& x : s) {
     int latest = -1;
     for (double t : times) {
       if (t <= x.t + 0.05) latest = static_cast<int>(std::lround((t - 0.013) / 0.05));
     }
+    if (x.t < 1.0 - 1e-9) {
+      used = latest;
+      continue;
+    }
+    if (latest == used) {
+      ++gaps;
+      EXPECT_TRUE(std::isnan(x.r)) << x.t;
+      continue;
+    }
+    ASSERT_FALSE(std::isnan(x.r)) << x.t;
     EXPECT_NEAR(x.r, yaw_rate_from_rot(latest), 1e-15) << x.t;
+    stand_ins += 0.05 * latest + 0.013 < x.t;  // measured before its grid time: a stand-in
+    used = latest;
   }
+  EXPECT_EQ(gaps, 38);       // grid times x.3 and x.8 from 1 s
+  EXPECT_EQ(stand_ins, 38);  // grid times x.1 and x.6, whose successor was due before the look
 }
 
 // A sentence that changes its rate (10 Hz, then 1 Hz from 5 s): learned again after three
 // intervals off the old period, then held over the grid times between arrivals.
 TEST(Assembler, ANewRateIsLearnedAgain) {
-  AssemblerConfig c;
+  AssemblerConfig c = until_due();
   c.max_age_s = 3.0;
-  SampleAssembler a(c);
-  for (int i = 0; i <= 50; ++i) a.add(0.1 * i, rot(1.0));
-  for (int i = 6; i <= 20; ++i) a.add(1.0 * i, rot(2.0));
-  a.advance(20.0);
-  EXPECT_NEAR(a.learned_period("ROT"), 1.0, 1e-9);
-  for (const auto& x : a.take()) {
-    if (x.t > 11.0) {
-      EXPECT_FALSE(std::isnan(x.r)) << x.t;  // 4 intervals of 1 s by 10 s
-    }
+  SampleAssembler b(c);
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.1 * i;
+    if (i <= 50 || i % 10 == 0) b.add(t, rot(i <= 50 ? 1.0 : 2.0));  // 1 Hz from 5 s
+    b.add(t, rsa(1.0));
   }
+  b.advance(20.0);
+  EXPECT_NEAR(b.learned_period("ROT"), 1.0, 1e-9);
+  const auto s = b.take();
+  ASSERT_EQ(s.size(), 201u);
+  int missing_after_9 = 0;
+  for (const auto& x : s) missing_after_9 += x.t > 9.0 && std::isnan(x.r);
+  // Learned again by 9 s (three intervals off the old period at 6, 7, 8 s, a fourth at 9 s),
+  // then held over the grid times between the arrivals.
+  EXPECT_EQ(missing_after_9, 0);
 }
 
 // The surge speed: where the water speed is withheld as a repetition (its VBW lost), u is
 // missing, not the ground speed for one sample.
 TEST(Assembler, AWithheldWaterSpeedIsNotReplacedByTheGroundSpeed) {
-  SampleAssembler a(AssemblerConfig{});
+  SampleAssembler a(until_due());
   for (int i = 0; i <= 30; ++i) {
     if (i != 20) a.add(0.1 * i, vbw(8.0, 0.0));
     a.add(0.1 * i, vtg(10.0));
@@ -302,7 +344,7 @@ TEST(Assembler, AWithheldWaterSpeedIsNotReplacedByTheGroundSpeed) {
 // between its arrivals, up to the next one's due time; a lost VBW leaves v missing until the
 // next one comes.
 TEST(Assembler, ASlowSentenceIsHeldUntilItsNextIsDue) {
-  AssemblerConfig c;
+  AssemblerConfig c = until_due();
   c.max_age_s = 3.0;
   SampleAssembler a(c);
   for (int i = 0; i <= 100; ++i) {
@@ -325,7 +367,7 @@ TEST(Assembler, ASlowSentenceIsHeldUntilItsNextIsDue) {
 // A sentence whose intervals scatter (an irregular sender) has no period: it is held up to
 // max_age_s as before.
 TEST(Assembler, AnIrregularSentenceIsHeldUpToMaxAge) {
-  SampleAssembler a(AssemblerConfig{});
+  SampleAssembler a(until_due());
   const double times[] = {0.0, 0.05, 0.4, 0.45, 0.9, 1.3, 1.32, 1.8, 2.0, 2.6, 2.65, 3.0};
   for (double t : times) a.add(t, rot(t * 10));
   a.advance(3.0);

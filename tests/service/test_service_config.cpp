@@ -198,7 +198,7 @@ service:
     interface: 127.0.0.1
     rate: 20
     max_age: 0.5
-    hold_until_due: false
+    hold_until_due: true
     receive_buffer: 65536
 )");
   // THEN each is applied, and the rudder sign follows model.B (b2 > 0: RSA's sign)
@@ -209,8 +209,8 @@ service:
   EXPECT_EQ(c.nmea.interface_address, "127.0.0.1");
   EXPECT_DOUBLE_EQ(c.nmea.assembler.rate_hz, 20.0);
   EXPECT_DOUBLE_EQ(c.nmea.assembler.max_age_s, 0.5);
-  EXPECT_FALSE(c.nmea.assembler.hold_until_due);
-  EXPECT_TRUE(d.nmea.assembler.hold_until_due);
+  EXPECT_TRUE(c.nmea.assembler.hold_until_due);
+  EXPECT_FALSE(d.nmea.assembler.hold_until_due);
   EXPECT_EQ(c.nmea.receive_buffer, 65536);
   EXPECT_EQ(c.nmea.assembler.rudder_sign, nmea::RudderSign::kPositiveToStarboard);
   EXPECT_EQ(d.nmea.assembler.rudder_sign, nmea::RudderSign::kPositiveToPort);  // b2 < 0

@@ -66,7 +66,7 @@ struct NmeaInputOptions {
   std::optional<double> cycle_rate_hz;
   double max_age_s = 1.0;  ///< a value older than this is missing in a sample [s]
   /// Missing once the sentence's next is due (nmea::AssemblerConfig::hold_until_due).
-  bool hold_until_due = true;
+  bool hold_until_due = false;
 };
 
 /// Lines counted under one reason.

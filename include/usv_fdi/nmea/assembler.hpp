@@ -27,20 +27,28 @@
 // on the grid (the time base starts at the first one), do not fall before or after it by
 // their jitter. The ages (g - tau) may then be negative, down to -L.
 //
-// Held until due (hold_until_due, the default): each sentence's period P is learned as the
+// Held until due (hold_until_due, off by default): each sentence's period P is learned as the
 // median of its last 15 intervals (once it has kMinIntervals; an interval under 2 ms is
 // another line of the same datagram or a copy, not an arrival), with a tolerance
 // tol = max(4.5 MAD, 2 ms) for the jitter. A sentence is not periodic, and is held up to
 // max_age_s, when its intervals scatter by more than P / 4 (MAD) or fewer than 80 % of them
 // are whole multiples of P (within max(tol, P / 8): a lost sentence makes an interval of 2 P;
 // two senders of one sentence make short and long intervals that are neither). Three
-// intervals in a row off P +- tol restart the learning from them (a new rate). A value
-// measured at tau that is already in a sample is not given again once its successor is due,
-// g + L >= tau + P - tol: a lost or late sentence is a gap in that quantity, not the previous
-// value again (a repeated value is a step of the signal's derivative, which the observers
-// read as a fault). A value not yet in a sample is given however late its successor. So
-// sentences faster than the grid give their latest value, and those slower than the grid
-// (VBW at 1 Hz on a 10 Hz grid) are held over the grid times between their arrivals.
+// intervals in a row off P +- tol restart the learning from them (a new rate); a copy within
+// 2 ms is not read. A value measured at tau that is already in a sample is not given again
+// once its successor is overdue, g + L >= tau + P + min(tol, L / 2): a lost or late sentence is a
+// gap in that quantity, not the previous value again (a repeated value is a step of the signal's
+// derivative, which the observers read as a fault). A value not yet in a sample is given
+// however late its successor. So sentences faster than the grid give their latest value, and
+// those slower than the grid (VBW at 1 Hz on a 10 Hz grid) are held over the grid times
+// between their arrivals.
+// Why off by default: L is the same for every sentence, so a sentence at the grid rate whose
+// times lie about L from the grid (another sender's phase than the first datagram's) falls
+// before or after the boundary by its jitter: gaps there (23 % of the grid times at a phase of
+// 50 +- 3 ms, in a review's simulation), where the zero-order hold has none; and a sentence
+// faster than the grid leads it by up to L. The cure, a look time per sentence centred on its
+// own phase, is not built. Use it where the senders' TAG times lie on the grid (one INS that
+// sends ROT, RSA and VBW together, the simulator).
 //
 // stale(t) names the sentences that have stopped: a quantity without a valid value for more
 // than max_age_s (or never received, max_age_s after the first input), with its age. (A
@@ -63,7 +71,7 @@ struct AssemblerConfig {
   /// Each value to the grid time nearest it, and not given again once its sentence's next is
   /// due (the period learned from the sentence's arrivals; see above); false: the latest value
   /// at or before the grid time, held up to max_age_s (zero-order hold).
-  bool hold_until_due = true;
+  bool hold_until_due = false;
   RudderSign rudder_sign = RudderSign::kPositiveToPort;  ///< the vessel model's (b2 < 0)
 };
 
@@ -155,7 +163,8 @@ class SampleAssembler {
     double period = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not learned
     double tolerance = 0.0;
     int off_period = 0;  ///< intervals in a row off period +- tolerance
-    void arrive(double t);
+    /// Learns from an arrival at t; false for a copy (within 2 ms of the last arrival).
+    bool arrive(double t);
   };
   enum Feed { kRot = 0, kRsa, kVbw, kVtg, kFeeds };
   struct Held {
