@@ -216,8 +216,7 @@ double SampleAssembler::at(Slot slot, double g, double* age) {
   const Arrivals& a = arrivals_[feed_of(slot)];
   // Already in a sample, and its successor overdue (beyond the jitter, at most half the
   // look-ahead) by g's look-ahead time: the successor is lost or late, and the value is not
-  // given again. (One not yet used is
-  // given, however late its successor: it is no repetition.)
+  // given again. (One not yet used is given, however late its successor: no repetition.)
   if (config_.hold_until_due && !std::isnan(a.period) && h.used &&
       g + look_ahead_ >= h.time + a.period + std::min(a.tolerance, 0.5 * look_ahead_)) {
     return kNaN;
