@@ -211,8 +211,6 @@ VesselNotes vessel_notes(std::uint32_t isolation_paused, std::uint32_t input_fla
     n.j_peak[c] = j_peak[c];
     n.j_raise[c] = j_raise[c];
     n.j_leave[c] = j_leave[c];
-    // (NaN peak: none computed; a comparison with NaN is false)
-    n.suspected[c] = j_leave[c] > 0.0 && j_peak[c] > j_leave[c];
   }
   return n;
 }
@@ -254,7 +252,7 @@ void add_vessel_notes(const VesselNotes& notes, Sensor sensor, DiagStatus* d) {
     return;
   }
   const int c = sensor == Sensor::kAccelerometer ? 0 : sensor == Sensor::kGyro ? 1 : -1;
-  if (c < 0 || !notes.suspected[c]) return;
+  if (c < 0 || !notes.suspected(c)) return;
   d->level = DiagLevel::kWarn;
   d->message = fmt::format(
       "suspected: the {} channel's residual J_N {:.3g} is above the level that clears a fault "

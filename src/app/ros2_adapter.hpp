@@ -195,13 +195,14 @@ DiagLevel diagnostic_level(Sensor sensor, const Row* row, double heard_age, doub
 /// after a clear.)
 struct VesselNotes {
   bool model_mismatch = false;  ///< isolation_paused & PAUSE_MODEL_MISMATCH
-  /// A suspicion per channel [accelerometer, gyro]: the status's peak J_N above the threshold
-  /// that clears a fault (j_leave > 0: one is in force), not yet at the one that raises. The
-  /// peak, the leave and the raise thresholds, for the message.
-  bool suspected[2] = {false, false};
+  /// The status's peak J_N per channel [accelerometer, gyro] and the thresholds that clear
+  /// and raise a fault (0: none in force).
   double j_peak[2] = {0.0, 0.0};
   double j_leave[2] = {0.0, 0.0};
   double j_raise[2] = {0.0, 0.0};
+  /// A suspicion of channel c: its peak above the level that clears a fault (one in force),
+  /// not raised. (NaN peak: none computed; a comparison with NaN is false.)
+  bool suspected(int c) const { return j_leave[c] > 0.0 && j_peak[c] > j_leave[c]; }
   // Inputs the sidecar cannot judge a sensor from now (input_flags, fdi::INPUT_*).
   bool ins_silent = false;      ///< INPUT_INS_SILENT
   bool rudder_missing = false;  ///< INPUT_RUDDER_MISSING (FDI paused)

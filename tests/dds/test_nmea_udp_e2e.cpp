@@ -65,15 +65,22 @@ std::string dump(const std::vector<MonitorEvent>& all) {
   return s;
 }
 
-/// The noise-free paper scenario (Otter, 10 Hz) as the simulator's NMEA log: its lines (ROT,
-/// RSA, VBW per sample, each after its TAG block), each ending in CR LF.
-void paper_nmea_lines(Fleet& f, std::vector<std::string>* lines) {
-  const std::string log_file = f.dir() + "paper.nmea";
+/// Writes the noise-free paper scenario (Otter, 10 Hz) as the simulator's NMEA log into the
+/// fleet's folder; *path its file.
+void write_paper_nmea(Fleet& f, std::string* path) {
+  *path = f.dir() + "paper.nmea";
   ASSERT_EQ(f.run_to_end("simlog",
                          {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
-                          "--noise-scale", "0", "--nmea", "--output", log_file},
+                          "--noise-scale", "0", "--nmea", "--output", *path},
                          seconds(60), nullptr, false),
             0);
+}
+
+/// The lines of that log (ROT, RSA, VBW per sample, each after its TAG block), each ending in
+/// CR LF.
+void paper_nmea_lines(Fleet& f, std::vector<std::string>* lines) {
+  std::string log_file;
+  ASSERT_NO_FATAL_FAILURE(write_paper_nmea(f, &log_file));
   std::ifstream in(log_file);
   for (std::string line; std::getline(in, line);) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -168,13 +175,9 @@ TEST(NmeaUdpEndToEnd, PaperScenarioOverMulticastRaisesAndIsolatesBothFaults) {
   // AND the live input raised what the log replay of the same voyage raises, at the same
   // (TAG) times with the same isolation: one code path (SampleAssembler::add_sentence), and
   // times that do not depend on when the datagrams arrived
-  const std::string log_file = f.dir() + "paper.nmea";
+  std::string log_file;
+  ASSERT_NO_FATAL_FAILURE(write_paper_nmea(f, &log_file));
   const std::string out = f.dir() + "replay.jsonl";
-  ASSERT_EQ(f.run_to_end("simlog",
-                         {"sim", "--vessel", "otter", "--scenario", "paper", "--rate", "10",
-                          "--noise-scale", "0", "--nmea", "--output", log_file},
-                         seconds(60), nullptr, false),
-            0);
   ASSERT_EQ(f.run_to_end("replay",
                          {"replay", "--config",
                           std::string(USV_FDI_SOURCE_DIR) + "/config/scenarios/paper.yaml",

@@ -417,8 +417,8 @@ TEST(Ros2Diagnostics, AResidualAboveItsClearLevelIsASuspicionWarning) {
   // GIVEN a status whose gyro residual peaked at 4.2, between the level that clears (3) and
   // the one that raises (6), and whose accelerometer residual is low
   const VesselNotes n = vessel_notes(0, 0, {1.0, 4.2}, {6.0, 6.0}, {3.0, 3.0});
-  EXPECT_FALSE(n.suspected[0]);
-  EXPECT_TRUE(n.suspected[1]);
+  EXPECT_FALSE(n.suspected(0));
+  EXPECT_TRUE(n.suspected(1));
   // THEN the gyro is WARN "suspected", with the numbers; the accelerometer OK
   const auto d = vessel_diagnostics(257000001, none, 0.1, 5.0, n);
   EXPECT_EQ(d[0].level, DiagLevel::kOk) << d[0].message;
@@ -441,8 +441,8 @@ TEST(Ros2Diagnostics, AResidualAboveItsClearLevelIsASuspicionWarning) {
             std::string::npos);
   // AND no suspicion without thresholds in force (not armed: 0) or without a statistic (NaN)
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(vessel_notes(0, 0, {9.0, 9.0}, {0.0, 0.0}, {0.0, 0.0}).suspected[1]);
-  EXPECT_FALSE(vessel_notes(0, 0, {nan, nan}, {6.0, 6.0}, {3.0, 3.0}).suspected[1]);
+  EXPECT_FALSE(vessel_notes(0, 0, {9.0, 9.0}, {0.0, 0.0}, {0.0, 0.0}).suspected(1));
+  EXPECT_FALSE(vessel_notes(0, 0, {nan, nan}, {6.0, 6.0}, {3.0, 3.0}).suspected(1));
 }
 
 TEST(Ros2Diagnostics, AStaleInputOfAHeardSidecarIsStaleForTheSensorsItConcerns) {

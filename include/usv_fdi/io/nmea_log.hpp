@@ -65,7 +65,8 @@ struct NmeaInputOptions {
   /// Sentence cycle rate of a log without TAG times [Hz]; empty: such lines have no time.
   std::optional<double> cycle_rate_hz;
   double max_age_s = 1.0;  ///< a value older than this is missing in a sample [s]
-  /// Missing once the sentence's next is due (nmea::AssemblerConfig::hold_until_due).
+  /// Nearest grid time, not again once the sentence's next is overdue
+  /// (nmea::AssemblerConfig::hold_until_due).
   bool hold_until_due = false;
 };
 

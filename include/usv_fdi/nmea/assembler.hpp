@@ -12,8 +12,8 @@
 //   VTG  -> u     [m/s]    = speed over ground, when no valid VBW water speed is fresh (a mode
 //                            indicator N, E, M or S makes it invalid)
 // A value whose status is V (or whose field is empty) invalidates the quantity from then on
-// without refreshing its age. Each quantity holds its latest valid value (zero-order hold)
-// until the next sentence of its kind is due (below), never longer than max_age_s.
+// without refreshing its age. Each quantity holds its latest valid value (zero-order hold),
+// never longer than max_age_s; with hold_until_due, not again once its next is overdue (below).
 //
 // Output: a sample at every grid time g = k / rate_hz (k integer, so several assemblers share
 // the same grid), holding each quantity's latest valid value measured at or before g's look
