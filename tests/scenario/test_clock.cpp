@@ -26,7 +26,7 @@ std::vector<SimRow> voyage(double duration, std::uint64_t seed, bool with_faults
   if (with_faults) {
     sim.faults.push_back({Sensor::kAccelerometer, FaultKind::kBias, 150.0, 160.0, 0.05});
     // 10 sigma in 10 s (a slower one is left to the end of the ramp: since the observers
-    // confirm a raise for isolation.enter_time, 2 s, a drift of 6.7 sigma in 10 s is no
+    // confirm a raise for isolation.enter_time (2.5 s), a drift of 6.7 sigma in 10 s is no
     // longer raised here)
     sim.faults.push_back({Sensor::kGyro, FaultKind::kDrift, 165.0, 175.0, 0.0005});
   }

@@ -62,7 +62,7 @@ struct IsolationParams {
   /// J_N above threshold this long raises (at least 1 sample), the other channel staying
   /// quiet: model mismatch lights the other channel within seconds, a single sensor's fault
   /// never (and the jump check raises a sudden offset at once) [s]
-  double enter_time = 2.0;
+  double enter_time = 2.5;
   double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
