@@ -737,14 +737,21 @@ TEST_P(ShutdownUnderLoad, SidecarExitsZeroWithinTwoSeconds) {
   const int sig = GetParam();
   // GIVEN a sidecar flooded with samples (as fast as the publisher can write, realistic noise)
   // and a monitor
-  f.start("monitor", {"monitor", "--json"});
+  ChildProcess& monitor = f.start("monitor", {"monitor", "--json", "--status"});
   ChildProcess& svc = f.start_service(
       "svc", f.write_service_config("svc", m, {"input_timeout: 60", "input_queue: 256"}), 1);
   ChildProcess& sim =
       f.start("sim", {"sim", "--publish", "--vessel", "otter", "--scenario", "paper", "--speed",
                       "10000", "--duration", "100000", "--reliable", "--mmsi", std::to_string(m)});
   ASSERT_TRUE(f.wait_for_log("svc", "1 INS writer(s)", seconds(15))) << f.log("svc");
-  std::this_thread::sleep_for(milliseconds(1500));
+  // Under load once its status has counted more than 1000 samples (a fixed wait was too short
+  // for a sidecar under ThreadSanitizer on a busy machine: 927 samples after 1.5 s).
+  std::vector<MonitorEvent> events;
+  std::vector<MonitorStatus> statuses;
+  std::string err;
+  ASSERT_TRUE(read_until_samples(monitor, &events, &statuses, {m}, 1001, seconds(60), &err))
+      << err << "\n"
+      << f.log("svc");
   ASSERT_TRUE(sim.running()) << f.log("sim");
   // WHEN it receives the signal
   StarvationMeter meter;
