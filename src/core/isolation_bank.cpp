@@ -98,10 +98,13 @@ void Isolator::publish_bank() {
 double Isolator::reachable_threshold() const { return 0.75 * p_.clip * p_.clip; }
 
 double Isolator::learned_threshold(std::vector<double>* healthy) const {
+  // The median, the MAD about it and the 99.9 % quantile (the value a sort would put at rank
+  // n 999/1000), by selection: this runs at every relearning.
   const double med = median_in_place(healthy);
-  const double sd = robust_std(healthy);
-  std::sort(healthy->begin(), healthy->end());
-  const double q999 = healthy->empty() ? 0.0 : (*healthy)[healthy->size() * 999 / 1000];
+  std::vector<double> dev;
+  const double sd = robust_std_about(*healthy, med, &dev);
+  const double q999 =
+      healthy->empty() ? 0.0 : upper_rank_after_median(healthy, healthy->size() * 999 / 1000);
   // A windowed mean of clipped squares cannot exceed clip^2: keep the threshold reachable.
   return std::min(std::max({p_.threshold, med + p_.threshold_k * sd, p_.threshold_margin * q999}),
                   reachable_threshold());

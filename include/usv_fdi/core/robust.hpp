@@ -17,14 +17,33 @@ inline double median_in_place(std::vector<double>* v) {
   return *mid;
 }
 
-/// 1.4826 x the median absolute deviation: the standard deviation for Gaussian data, robust
-/// to outliers and to a fault covering less than half of the data (0 for fewer than two).
+/// 1.4826 x the median absolute deviation about m (the median of the values): the standard
+/// deviation for Gaussian data, robust to outliers and to a fault covering less than half of
+/// the data (0 for fewer than two). The values are kept; scratch holds the deviations.
+inline double robust_std_about(const std::vector<double>& v, double m,
+                               std::vector<double>* scratch) {
+  if (v.size() < 2) return 0.0;
+  scratch->resize(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) (*scratch)[i] = std::abs(v[i] - m);
+  return 1.4826 * median_in_place(scratch);
+}
+
+/// robust_std_about the values' median, reordering them.
 inline double robust_std(std::vector<double>* v) {
   if (v->size() < 2) return 0.0;
-  const double m = median_in_place(v);
-  std::vector<double> dev(v->size());
-  for (std::size_t i = 0; i < v->size(); ++i) dev[i] = std::abs((*v)[i] - m);
-  return 1.4826 * median_in_place(&dev);
+  std::vector<double> dev;
+  return robust_std_about(*v, median_in_place(v), &dev);
+}
+
+/// The value of rank k (0-based) of the values, reordering them, when they were last
+/// reordered by median_in_place: the search is confined to the upper half for k at or above
+/// the median's rank (the same value std::sort would put at k).
+inline double upper_rank_after_median(std::vector<double>* v, std::size_t k) {
+  const std::size_t mid = v->size() / 2;
+  const auto first = v->begin() + static_cast<std::ptrdiff_t>(k >= mid ? mid : 0);
+  const auto kth = v->begin() + static_cast<std::ptrdiff_t>(k);
+  std::nth_element(first, kth, v->end());
+  return *kth;
 }
 
 }  // namespace usvfdi
