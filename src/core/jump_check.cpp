@@ -176,6 +176,20 @@ void JumpCheck::push(double t, double z, double I, double delta) {
   z_.push(z);
   i_.push(I);
   d_.push(delta);
+  // The rudder's range over the samples the step statistics use (the newest L + M), kept as
+  // they come: a rescan only when the sample that left was the lowest or the highest.
+  const int held = std::min(d_.count(), L_ + M_);
+  const double left = d_.count() > L_ + M_ ? d_.at(L_ + M_) : kNaN;
+  if (held == 1 || left == delta_lo_ || left == delta_hi_) {
+    delta_lo_ = delta_hi_ = delta;
+    for (int back = 1; back < held; ++back) {
+      delta_lo_ = std::min(delta_lo_, d_.at(back));
+      delta_hi_ = std::max(delta_hi_, d_.at(back));
+    }
+  } else {
+    delta_lo_ = std::min(delta_lo_, delta);
+    delta_hi_ = std::max(delta_hi_, delta);
+  }
   ts_[static_cast<std::size_t>(z_.newest())] = t;
 }
 
@@ -194,13 +208,17 @@ void JumpCheck::keep_newest(int keep) {
 }
 
 void JumpCheck::step_statistics(int* m_best, double* f_best) {
-  T_ = T_learn_ = 0.0;
+  T_ = T_learn_ = swing_ = 0.0;
   *m_best = -1;
   *f_best = 0.0;
   const int m_hi = std::min(M_ - 1, z_.count() - L_ - 1);
   if (m_hi < 0) return;
   z_.steps(m_hi, f_.data());
   if (m_hi < persist_ - 1) return;
+  // The rudder's range over the samples held (learned with the step statistic: how far the
+  // rudder swung in the healthy past that set the bar).
+  const double delta_max = std::max(std::abs(delta_lo_), std::abs(delta_hi_));
+  swing_ = delta_hi_ - delta_lo_;
   const double s2 = sigma_ * sigma_;
   double raw = 0.0;
   for (int m = persist_ - 1; m <= m_hi; ++m) raw = std::max(raw, f_[m] * f_[m] * inv_c_[m]);
@@ -216,10 +234,13 @@ void JumpCheck::step_statistics(int* m_best, double* f_best) {
   // The largest bend the rudder can drive in these windows: |z''| = |a_row . x'| with x'
   // driven by b delta, so at most bend_rate |b| max|delta| (a hull whose rudder is near
   // midships, holding a course in waves, bends z with the waves, which the bar learned).
-  double delta_max = 0.0;
-  for (int back = 0; back <= m_hi + L_; ++back)
-    delta_max = std::max(delta_max, std::abs(d_.at(back)));
-  const double bend_cap = p_.bend_rate * std::abs(b_) * delta_max;
+  const double bend_cap = p_.bend_rate * std::abs(b_) * std::max(delta_max, swing_);
+  // A rudder swinging further than in the healthy past the bar was learned from (the first
+  // zigzag execute after course keeping) changes x' by about B times the extra swing, and z''
+  // by up to bend_rate |b| times it, a bend not yet under way before the onset. (A swing the
+  // bar has seen is in the bar already: course keeping and course changes lose nothing.)
+  const double new_swing = std::max(0.0, swing_ - healthy_.max(2));
+  const double swing_bend = p_.bend_rate * std::abs(b_) * new_swing;
   for (int m = persist_ - 1; m <= m_hi; ++m) {
     // z's bend before the onset: the change of its slope from the pre window before the
     // last to the last [per s^2] (when the samples held reach back that far).
@@ -232,7 +253,7 @@ void JumpCheck::step_statistics(int* m_best, double* f_best) {
     // hull's bends put it, and the discount only keeps a bend under way from crossing it.
     const double learn_excess = std::max(0.0, std::abs(f_[m]) - rudder_doubt);
     T_learn_ = std::max(T_learn_, learn_excess * learn_excess / (s2 * c_[m]));
-    const double bend = std::min(p_.bend_margin * std::abs(zdd), bend_cap);
+    const double bend = std::min(p_.bend_margin * std::abs(zdd) + swing_bend, bend_cap);
     const double excess =
         std::max(0.0, std::abs(f_[m]) - rudder_doubt - bend * bend_[static_cast<std::size_t>(m)]);
     const double Tm = excess * excess / (s2 * c_[m]);
@@ -312,7 +333,7 @@ void JumpCheck::learn(const Pending& s) {
   average(&sigma2_, s.d2sq);
   learned_ += dt_;
   // The healthy maxima, once the scales have settled.
-  if (learned_ >= 0.5 * p_.learn_time) healthy_.add(s.t, {s.T, s.N});
+  if (learned_ >= 0.5 * p_.learn_time) healthy_.add(s.t, {s.T, s.N, s.swing});
 }
 
 JumpVerdict JumpCheck::update(double t, double y, double delta, bool learn_ok) {
@@ -362,7 +383,8 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
   const double e2 = f_[0] * f_[0] / c_[0];
   const double d2 = z_.at(0) - 2.0 * z_.at(1) + z_.at(2);
   noise_statistic(d2 * d2);
-  queue_for_learning(Pending{t, T_learn_, N_, e2, d2 * d2, learn_ok && !raised_ && !noise_raised_});
+  queue_for_learning(
+      Pending{t, T_learn_, N_, e2, d2 * d2, swing_, learn_ok && !raised_ && !noise_raised_});
   armed_ = p_.enabled && learned_ >= p_.learn_time;
   // Watched from half the learning on (the scales have settled), reported once armed: a
   // fault before arming is kept out of the learning, and its end is not taken for a new one.

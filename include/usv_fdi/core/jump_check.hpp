@@ -70,7 +70,10 @@ struct JumpParams {
   /// z's slope between the two pre windows before the onset (the bend seen may grow
   /// bend_margin times), and the rudder bounds the bend it can drive (a hull's rate 1/T up to
   /// bend_rate), so that waves, which bend z with the rudder near midships, are no excuse.
-  /// Either 0: no such discount [-], [1/s].
+  /// A rudder that swings further within the windows than it did in the healthy past the bar
+  /// learned from (a first zigzag execute after course keeping) starts a bend the pre window
+  /// has not seen yet: bend_rate |b| times that extra swing is added to |z''| (within the
+  /// same bound). Either 0: no such discount [-], [1/s].
   double bend_margin = 2.0;
   double bend_rate = 2.0;
 
@@ -109,7 +112,9 @@ class JumpCheck {
   bool armed() const { return armed_; }
   bool jump_raised() const { return raised_; }
   bool noise_raised() const { return noise_raised_; }
-  double statistic() const { return T_; }          ///< max_m T_m of the last sample
+  double statistic() const { return T_; }  ///< max_m T_m of the last sample
+  /// The range of the rudder angle over the samples held (the pre and post windows) [rad].
+  double swing() const { return swing_; }
   double threshold() const { return threshold_; }  ///< in force (0 before arming)
   double noise_statistic() const { return N_; }
   double noise_threshold() const { return noise_threshold_; }
@@ -151,7 +156,7 @@ class JumpCheck {
     int since_exact_ = 0;
   };
   struct Pending {
-    double t, T, N, e2, d2sq;
+    double t, T, N, e2, d2sq, swing;
     bool ok;
   };
 
@@ -204,7 +209,7 @@ class JumpCheck {
   double sigma_seen_ = 0.0;
   double learned_ = 0.0;  ///< healthy time seen [s]
   bool armed_ = false;
-  HealthyMaxima<2> healthy_;      ///< of the step and the noise statistic
+  HealthyMaxima<3> healthy_;      ///< of the step and the noise statistic, and the rudder's swing
   std::vector<Pending> pending_;  ///< samples not yet learned from (a ring, oldest first)
   std::size_t pending_head_ = 0, pending_n_ = 0;
   std::vector<double> d2_;  ///< ring of the last squared second differences (noise window)
@@ -214,6 +219,8 @@ class JumpCheck {
   // Verdicts.
   double T_ = 0.0, N_ = 0.0;
   double T_learn_ = 0.0;  ///< T without the bend's discount: what the healthy maximum learns
+  double swing_ = 0.0;    ///< the rudder's range over the samples held [rad]
+  double delta_lo_ = 0.0, delta_hi_ = 0.0;  ///< the rudder's lowest and highest there [rad]
   double threshold_ = 0.0, noise_threshold_ = 0.0;
   bool raised_ = false;
   bool step_reported_ = false, noise_reported_ = false;  ///< their raise was reported
