@@ -177,18 +177,40 @@ void JumpCheck::push(double t, double z, double I, double delta) {
   i_.push(I);
   d_.push(delta);
   // The rudder's range over the samples the step statistics use (the newest L + M), kept as
-  // they come: a rescan only when the sample that left was the lowest or the highest.
+  // they come with the number of samples at each end: a rescan only when the last sample at
+  // the lowest or the highest angle has left.
   const int held = std::min(d_.count(), L_ + M_);
-  const double left = d_.count() > L_ + M_ ? d_.at(L_ + M_) : kNaN;
-  if (held == 1 || left == delta_lo_ || left == delta_hi_) {
+  if (d_.count() > L_ + M_) {
+    const double left = d_.at(L_ + M_);
+    if (left == delta_lo_) --n_lo_;
+    if (left == delta_hi_) --n_hi_;
+  }
+  if (held == 1) {
+    delta_lo_ = delta_hi_ = delta;
+    n_lo_ = n_hi_ = 1;
+  } else {
+    if (delta < delta_lo_) {
+      delta_lo_ = delta;
+      n_lo_ = 0;
+    }
+    if (delta > delta_hi_) {
+      delta_hi_ = delta;
+      n_hi_ = 0;
+    }
+    n_lo_ += delta == delta_lo_;
+    n_hi_ += delta == delta_hi_;
+  }
+  if (n_lo_ <= 0 || n_hi_ <= 0) {
     delta_lo_ = delta_hi_ = delta;
     for (int back = 1; back < held; ++back) {
       delta_lo_ = std::min(delta_lo_, d_.at(back));
       delta_hi_ = std::max(delta_hi_, d_.at(back));
     }
-  } else {
-    delta_lo_ = std::min(delta_lo_, delta);
-    delta_hi_ = std::max(delta_hi_, delta);
+    n_lo_ = n_hi_ = 0;
+    for (int back = 0; back < held; ++back) {
+      n_lo_ += d_.at(back) == delta_lo_;
+      n_hi_ += d_.at(back) == delta_hi_;
+    }
   }
   ts_[static_cast<std::size_t>(z_.newest())] = t;
 }

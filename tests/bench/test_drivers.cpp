@@ -156,7 +156,7 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
   // minutes of course changes, then the first 10 deg zigzag at 120 s. Its rudder swing bends
   // z = r - b int(delta) by a_row B int int(delta), more than anything the jump check learned
   // before and not yet seen before the onset; up to stop 34 the jump check raised a gyro bias
-  // at 121.4 s (in 55 of the table's 56 such runs) and again at 125 s, held for 30 s
+  // at 121.4 s (in 35 of the table's 53 such runs) and again at 125 s, held for 30 s
   BenchOptions opt;
   opt.config_dir = std::string(USV_FDI_SOURCE_DIR) + "/config";
   EngineConfig engine_cfg, paper_cfg;

@@ -2,6 +2,7 @@
 // INS channel for sudden offsets and noise rises.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -150,6 +151,28 @@ TEST(JumpCheck, AnHourOfHealthyDataWithAWrongBAndALaggingRudderRaisesNothing) {
     const Seen s = run_check(rows);
     EXPECT_TRUE(s.steps.empty());
     EXPECT_TRUE(s.noises.empty());
+  }
+}
+
+TEST(JumpCheck, TheRuddersSwingIsItsRangeOverTheWindowsAlsoWithRepeatedAngles) {
+  // GIVEN a rudder sensor that prints whole degrees (long runs of equal angles) at 10 Hz:
+  // the windows hold L + M = 10 + 5 samples
+  JumpParams p;
+  JumpCheck check(p, kB, 1e-4);
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<int> step(-1, 1);
+  std::vector<double> seen;
+  int deg = 0;
+  for (long k = 0; k < 3000; ++k) {
+    if (k % 3 == 0) deg = std::clamp(deg + step(rng), -6, 6);
+    const double delta = deg * M_PI / 180.0;
+    seen.push_back(delta);
+    check.update(0.1 * k, 0.01 * std::sin(0.01 * k), delta, true);
+    if (k < 50) continue;
+    // THEN its swing is max - min of the newest 15 angles, on every sample
+    const auto first = seen.end() - 15;
+    const double want = *std::max_element(first, seen.end()) - *std::min_element(first, seen.end());
+    ASSERT_DOUBLE_EQ(check.swing(), want) << "sample " << k;
   }
 }
 

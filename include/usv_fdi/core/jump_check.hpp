@@ -221,6 +221,7 @@ class JumpCheck {
   double T_learn_ = 0.0;  ///< T without the bend's discount: what the healthy maximum learns
   double swing_ = 0.0;    ///< the rudder's range over the samples held [rad]
   double delta_lo_ = 0.0, delta_hi_ = 0.0;  ///< the rudder's lowest and highest there [rad]
+  int n_lo_ = 0, n_hi_ = 0;                 ///< ... and how many samples are at each
   double threshold_ = 0.0, noise_threshold_ = 0.0;
   bool raised_ = false;
   bool step_reported_ = false, noise_reported_ = false;  ///< their raise was reported
