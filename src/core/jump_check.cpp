@@ -59,6 +59,36 @@ void JumpParams::validate() const {
 
 // ------------------------------------------------------------------------------ Series
 
+void JumpCheck::SlidingRange::reset(int w) {
+  w_ = std::max(1, w);
+  for (Queue* q : {&lo_, &hi_}) q->ring.assign(static_cast<std::size_t>(w_ + 1), {0, 0.0});
+  clear();
+}
+
+void JumpCheck::SlidingRange::clear() {
+  n_ = 0;
+  for (Queue* q : {&lo_, &hi_}) q->head = q->size = 0;
+}
+
+template <typename Keep>
+void JumpCheck::SlidingRange::add(Queue* q, double x, Keep keep) {
+  const int cap = static_cast<int>(q->ring.size());
+  // Values older than the window leave at the front; values that x outdoes at the back.
+  while (q->size > 0 && q->at(0).first <= n_ - w_) {
+    q->head = (q->head + 1) % cap;
+    --q->size;
+  }
+  while (q->size > 0 && !keep(q->at(q->size - 1).second, x)) --q->size;
+  q->ring[static_cast<std::size_t>((q->head + q->size) % cap)] = {n_, x};
+  ++q->size;
+}
+
+void JumpCheck::SlidingRange::push(double x) {
+  ++n_;
+  add(&lo_, x, [](double back, double v) { return back < v; });
+  add(&hi_, x, [](double back, double v) { return back > v; });
+}
+
 void JumpCheck::Series::reset(int L, int M) {
   L_ = L;
   M_ = M;
@@ -139,6 +169,7 @@ void JumpCheck::resize_windows() {
   persist_ = std::min(
       M_, std::max(p_.persist_samples, static_cast<int>(std::lround(p_.persist_time / dt_)) + 1));
   for (Series* s : {&z_, &i_, &d_}) s->reset(L_, M_);
+  d_range_.reset(L_ + M_);
   ts_.assign(static_cast<std::size_t>(L_ + M_ + 1), 0.0);
   c_.resize(static_cast<std::size_t>(M_));
   const double Sjj = L_ * (static_cast<double>(L_) * L_ - 1.0) / 12.0;
@@ -166,6 +197,7 @@ void JumpCheck::resize_windows() {
 
 void JumpCheck::restart() {
   for (Series* s : {&z_, &i_, &d_}) s->clear();
+  d_range_.clear();
   I_ = 0.0;
   last_t_ = last_z_ = last_I_ = last_d_ = kNaN;
   d2_n_ = d2_next_ = 0;
@@ -176,42 +208,7 @@ void JumpCheck::push(double t, double z, double I, double delta) {
   z_.push(z);
   i_.push(I);
   d_.push(delta);
-  // The rudder's range over the samples the step statistics use (the newest L + M), kept as
-  // they come with the number of samples at each end: a rescan only when the last sample at
-  // the lowest or the highest angle has left.
-  const int held = std::min(d_.count(), L_ + M_);
-  if (d_.count() > L_ + M_) {
-    const double left = d_.at(L_ + M_);
-    if (left == delta_lo_) --n_lo_;
-    if (left == delta_hi_) --n_hi_;
-  }
-  if (held == 1) {
-    delta_lo_ = delta_hi_ = delta;
-    n_lo_ = n_hi_ = 1;
-  } else {
-    if (delta < delta_lo_) {
-      delta_lo_ = delta;
-      n_lo_ = 0;
-    }
-    if (delta > delta_hi_) {
-      delta_hi_ = delta;
-      n_hi_ = 0;
-    }
-    n_lo_ += delta == delta_lo_;
-    n_hi_ += delta == delta_hi_;
-  }
-  if (n_lo_ <= 0 || n_hi_ <= 0) {
-    delta_lo_ = delta_hi_ = delta;
-    for (int back = 1; back < held; ++back) {
-      delta_lo_ = std::min(delta_lo_, d_.at(back));
-      delta_hi_ = std::max(delta_hi_, d_.at(back));
-    }
-    n_lo_ = n_hi_ = 0;
-    for (int back = 0; back < held; ++back) {
-      n_lo_ += d_.at(back) == delta_lo_;
-      n_hi_ += d_.at(back) == delta_hi_;
-    }
-  }
+  d_range_.push(delta);  // the range over the newest L + M: the samples the statistics use
   ts_[static_cast<std::size_t>(z_.newest())] = t;
 }
 
@@ -226,6 +223,7 @@ void JumpCheck::keep_newest(int keep) {
     d[k] = d_.at(back);
   }
   for (Series* s : {&z_, &i_, &d_}) s->clear();
+  d_range_.clear();
   for (int k = 0; k < keep; ++k) push(t[k], z[k], I[k], d[k]);
 }
 
@@ -239,8 +237,8 @@ void JumpCheck::step_statistics(int* m_best, double* f_best) {
   if (m_hi < persist_ - 1) return;
   // The rudder's range over the samples held (learned with the step statistic: how far the
   // rudder swung in the healthy past that set the bar).
-  const double delta_max = std::max(std::abs(delta_lo_), std::abs(delta_hi_));
-  swing_ = delta_hi_ - delta_lo_;
+  const double delta_max = std::max(std::abs(d_range_.lo()), std::abs(d_range_.hi()));
+  swing_ = d_range_.hi() - d_range_.lo();
   const double s2 = sigma_ * sigma_;
   double raw = 0.0;
   for (int m = persist_ - 1; m <= m_hi; ++m) raw = std::max(raw, f_[m] * f_[m] * inv_c_[m]);

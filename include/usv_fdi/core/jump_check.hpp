@@ -34,6 +34,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "usv_fdi/core/healthy_maxima.hpp"
@@ -124,6 +125,32 @@ class JumpCheck {
  private:
   /// Equally spaced samples of one series in a ring, with the line fitted to the L samples
   /// ending at each of the last M + 1 samples (sliding sums: O(1) per sample).
+  /// The lowest and highest of the newest w values pushed, in O(1) amortised per value (two
+  /// monotonic queues of the values that may still become the extreme, in rings).
+  class SlidingRange {
+   public:
+    void reset(int w);
+    void clear();
+    void push(double x);
+    double lo() const { return lo_.front(); }  ///< (after at least one push)
+    double hi() const { return hi_.front(); }
+
+   private:
+    struct Queue {
+      std::vector<std::pair<long long, double>> ring;  ///< (sequence number, value)
+      int head = 0, size = 0;
+      const std::pair<long long, double>& at(int k) const {
+        return ring[static_cast<std::size_t>((head + k) % static_cast<int>(ring.size()))];
+      }
+      double front() const { return at(0).second; }
+    };
+    /// Appends x to q after dropping the values it makes irrelevant (keep(back, x) false).
+    template <typename Keep>
+    void add(Queue* q, double x, Keep keep);
+    int w_ = 1;
+    long long n_ = 0;  ///< values pushed since clear()
+    Queue lo_, hi_;
+  };
   class Series {
    public:
     void reset(int L, int M);
@@ -220,8 +247,7 @@ class JumpCheck {
   double T_ = 0.0, N_ = 0.0;
   double T_learn_ = 0.0;  ///< T without the bend's discount: what the healthy maximum learns
   double swing_ = 0.0;    ///< the rudder's range over the samples held [rad]
-  double delta_lo_ = 0.0, delta_hi_ = 0.0;  ///< the rudder's lowest and highest there [rad]
-  int n_lo_ = 0, n_hi_ = 0;                 ///< ... and how many samples are at each
+  SlidingRange d_range_;  ///< the rudder's range over the newest L + M samples
   double threshold_ = 0.0, noise_threshold_ = 0.0;
   bool raised_ = false;
   bool step_reported_ = false, noise_reported_ = false;  ///< their raise was reported
