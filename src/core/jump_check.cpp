@@ -252,8 +252,8 @@ void JumpCheck::step_statistics(int* m_best, double* f_best) {
   i_.steps(m_hi, fi_.data());
   d_.steps(m_hi, fd_.data());
   // The largest bend the rudder can drive in these windows: |z''| = |a_row . x'| with x'
-  // driven by b delta, so at most bend_rate |b| max|delta| (a hull whose rudder is near
-  // midships, holding a course in waves, bends z with the waves, which the bar learned).
+  // driven by b delta, so at most bend_rate |b| max(max|delta|, swing) (a hull whose rudder is
+  // near midships, holding a course in waves, bends z with the waves, which the bar learned).
   const double bend_cap = p_.bend_rate * std::abs(b_) * std::max(delta_max, swing_);
   // A rudder swinging further than in the healthy past the bar was learned from (the first
   // zigzag execute after course keeping) changes x' by about B times the extra swing, and z''

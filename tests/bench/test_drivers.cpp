@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string>
 
 #include "drivers.hpp"
 #include "runner.hpp"
@@ -77,29 +80,43 @@ TEST(BenchDrivers, TheEngineReportsItsEstimateAndArming) {
   }
 }
 
+/// The proving ground's run of that table, voyage, seed and kind, as the full mode of
+/// `usv-fdi-bench-detection` builds it, and the shipped engine configuration with its B (what
+/// a user gives); none when the proving ground no longer has it.
+std::optional<Case> proving_ground_run(const std::string& table, const std::string& voyage,
+                                       std::uint64_t seed, bool faulty, EngineConfig* engine_cfg) {
+  BenchOptions opt;
+  opt.config_dir = std::string(USV_FDI_SOURCE_DIR) + "/config";
+  EngineConfig paper_cfg;
+  load_configs(opt.config_dir, engine_cfg, &paper_cfg);
+  for (const Case& c : make_cases(opt)) {
+    if (c.table == table && c.voyage == voyage && c.seed == seed && c.faulty == faulty) {
+      engine_cfg->B = c.B;
+      return c;
+    }
+  }
+  return std::nullopt;
+}
+
+/// Every raise of the engine's run is a failure (the run is healthy).
+void expect_no_raise(const MethodResult& r) {
+  for (const Alarm& a : r.alarms) {
+    if (a.raised) ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
+  }
+}
+
 TEST(BenchDrivers, ABiasTheJumpCheckRaisedIsNotShownRectifiedBeforeHoldMax) {
   // GIVEN a proving-ground run (Esso Osaka, 50 Hz, calm course changes) with a 10 sigma
   // accelerometer bias on [1106.1, 1166.1) s, raised by the jump check once the observers are
   // live. Up to stop 30 the observers alone held it and showed it rectified 3 s after its
   // raise (5 % of its time shown).
-  BenchOptions opt;
-  opt.config_dir = std::string(USV_FDI_SOURCE_DIR) + "/config";
-  EngineConfig engine_cfg, paper_cfg;
-  load_configs(opt.config_dir, &engine_cfg, &paper_cfg);
-  const std::vector<Case> cases = make_cases(opt);
-  const Case* pick = nullptr;
-  for (const Case& c : cases) {
-    if (c.table == "esso-tanker @ 50 Hz" && c.voyage == "course/calm" &&
-        c.seed == 12323007886022702073ull && c.faulty) {
-      pick = &c;
-      break;
-    }
-  }
-  ASSERT_NE(pick, nullptr) << "the proving ground no longer has this run";
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick = proving_ground_run("esso-tanker @ 50 Hz", "course/calm",
+                                                      12323007886022702073ull, true, &engine_cfg);
+  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
   ASSERT_EQ(pick->fault.sensor, Sensor::kAccelerometer);
   ASSERT_EQ(pick->fault.kind, FaultKind::kBias);
   const Stream data = pick->make();
-  engine_cfg.B = pick->B;  // what a user gives
   const MethodResult r = run_engine(engine_cfg, data.samples);
   ASSERT_TRUE(std::isfinite(r.t_armed));
   ASSERT_LT(r.t_armed, pick->fault.t_start);
@@ -126,28 +143,15 @@ TEST(BenchDrivers, ShortResidualRisesOfAManoeuvringHullInWavesRaiseNothing) {
   // with MEMS-grade sensors) on which the observers, confirming a raise over 2 s, raised 18
   // false accelerometer faults after 13 100 s, each of the residual's rises lasting little
   // more than the confirmation
-  BenchOptions opt;
-  opt.config_dir = std::string(USV_FDI_SOURCE_DIR) + "/config";
-  EngineConfig engine_cfg, paper_cfg;
-  load_configs(opt.config_dir, &engine_cfg, &paper_cfg);
-  const std::vector<Case> cases = make_cases(opt);
-  const Case* pick = nullptr;
-  for (const Case& c : cases) {
-    if (c.table == "mariner @ 10 Hz" && c.voyage == "voyage/sea3/mems" &&
-        c.seed == 13566731111258911605ull && !c.faulty) {
-      pick = &c;
-      break;
-    }
-  }
-  ASSERT_NE(pick, nullptr) << "the proving ground no longer has this run";
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick = proving_ground_run("mariner @ 10 Hz", "voyage/sea3/mems",
+                                                      13566731111258911605ull, false, &engine_cfg);
+  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
   const Stream data = pick->make();
-  engine_cfg.B = pick->B;  // what a user gives
   // WHEN the engine with the shipped configuration replays it
   const MethodResult r = run_engine(engine_cfg, data.samples);
   // THEN it raises nothing (isolation.enter_time 2.5 s)
-  for (const Alarm& a : r.alarms) {
-    if (a.raised) ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
-  }
+  expect_no_raise(r);
 }
 
 TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
@@ -157,33 +161,20 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
   // z = r - b int(delta) by a_row B int int(delta), more than anything the jump check learned
   // before and not yet seen before the onset; up to stop 34 the jump check raised a gyro bias
   // at 121.4 s (in 35 of the table's 53 such runs) and again at 125 s, held for 30 s
-  BenchOptions opt;
-  opt.config_dir = std::string(USV_FDI_SOURCE_DIR) + "/config";
-  EngineConfig engine_cfg, paper_cfg;
-  load_configs(opt.config_dir, &engine_cfg, &paper_cfg);
-  const std::vector<Case> cases = make_cases(opt);
-  const Case* pick = nullptr;
-  for (const Case& c : cases) {
-    if (c.table == "otter3dof @ 50 Hz" && c.voyage == "voyage/sea3/mems" &&
-        c.seed == 15504103307926617233ull && !c.faulty) {
-      pick = &c;
-      break;
-    }
-  }
-  ASSERT_NE(pick, nullptr) << "the proving ground no longer has this run";
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick = proving_ground_run("otter3dof @ 50 Hz", "voyage/sea3/mems",
+                                                      15504103307926617233ull, false, &engine_cfg);
+  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
   Stream data = pick->make();
   // (its first 300 s: the zigzag and the speed changes' start)
   std::vector<Sample> first;
   for (const Sample& s : data.samples) {
     if (s.t <= 300.0) first.push_back(s);
   }
-  engine_cfg.B = pick->B;  // what a user gives
   // WHEN the engine with the shipped configuration replays it
   const MethodResult r = run_engine(engine_cfg, first);
   // THEN it raises nothing
-  for (const Alarm& a : r.alarms) {
-    if (a.raised) ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
-  }
+  expect_no_raise(r);
 }
 
 }  // namespace

@@ -123,8 +123,6 @@ class JumpCheck {
   double interval() const { return dt_; }  ///< learned sample interval [s]
 
  private:
-  /// Equally spaced samples of one series in a ring, with the line fitted to the L samples
-  /// ending at each of the last M + 1 samples (sliding sums: O(1) per sample).
   /// The lowest and highest of the newest w values pushed, in O(1) amortised per value (two
   /// monotonic queues of the values that may still become the extreme, in rings).
   class SlidingRange {
@@ -151,6 +149,8 @@ class JumpCheck {
     long long n_ = 0;  ///< values pushed since clear()
     Queue lo_, hi_;
   };
+  /// Equally spaced samples of one series in a ring, with the line fitted to the L samples
+  /// ending at each of the last M + 1 samples (sliding sums: O(1) per sample).
   class Series {
    public:
     void reset(int L, int M);
