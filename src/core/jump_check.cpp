@@ -418,10 +418,17 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
 
 void JumpCheck::integrate_rudder(double t, double delta) {
   // The rudder integral over every interval, once (the angle held over a missing one),
-  // whether or not this sample's y is usable.
+  // whether or not this sample's y is usable. Once the interval is learned, a step is a
+  // whole number of intervals: the samples are taken as equally spaced (z's windows count
+  // samples), and the jitter of a stamp (a receive time) would otherwise move I by delta
+  // times it and z by b delta times it, in a hard turn more than the gyro's noise.
   const double d_now = std::isfinite(delta) ? delta : last_delta_;
   if (std::isfinite(int_t_) && std::isfinite(last_delta_) && std::isfinite(d_now)) {
-    I_ += 0.5 * (last_delta_ + d_now) * (t - int_t_);
+    double step = t - int_t_;
+    if (dt_seen_ >= kIntervalSamples && dt_ > 0) {
+      step = dt_ * static_cast<double>(std::max(1L, std::lround(step / dt_)));
+    }
+    I_ += 0.5 * (last_delta_ + d_now) * step;
   }
   int_t_ = t;
   last_delta_ = d_now;

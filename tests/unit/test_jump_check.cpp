@@ -154,6 +154,45 @@ TEST(JumpCheck, AnHourOfHealthyDataWithAWrongBAndALaggingRudderRaisesNothing) {
   }
 }
 
+TEST(JumpCheck, StampJitterInAHardTurnIsNeitherANoiseRiseNorAJump) {
+  // GIVEN a yaw-rate channel at 50 Hz (a small craft's b = -2.2 1/s^2, white noise of
+  // 0.5 mrad/s) whose samples are taken on time but stamped on arrival, 2 ms (1 sigma) late
+  // or early, and a helm that keeps the rudder near midships for two minutes and then puts
+  // it hard over to +-0.5 rad (a zigzag) for four: with the stamps' intervals the rudder
+  // integral would be off by delta times the jitter, z by b delta times it, 4 sigma at
+  // 0.5 rad
+  const double rate = 50.0, h = 1.0 / rate, b = -2.2, sigma = 5e-4;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  JumpParams p;
+  JumpCheck check(p, b, 1e-5);
+  double I = 0.0, delta_prev = 0.0;
+  int raised = 0;
+  for (long k = 0; k * h <= 360.0; ++k) {
+    const double t = k * h;
+    // (put over at 0.5 rad/s, held for 10 s, to the other side, ...)
+    const double phase = std::fmod(t - 120.0, 22.0);
+    const double delta = t < 120.0    ? 0.02 * std::sin(2.0 * M_PI * t / 40.0)
+                         : phase < 1  ? 0.5 * phase
+                         : phase < 11 ? 0.5
+                         : phase < 13 ? 0.5 - 0.5 * (phase - 11.0)
+                         : phase < 21 ? -0.5
+                                      : -0.5 + 0.5 * (phase - 21.0);
+    if (k > 0) I += 0.5 * (delta + delta_prev) * h;
+    delta_prev = delta;
+    const double y = 0.05 * std::sin(2.0 * M_PI * t / 300.0) + b * I + sigma * n01(rng);
+    const double stamp = t + std::clamp(0.002 * n01(rng), -0.45 * h, 0.45 * h);
+    // WHEN the check takes the stamped samples
+    const JumpVerdict v = check.update(stamp, y, delta, !check.jump_raised());
+    // THEN it raises neither a noise rise nor a jump
+    if (v.noise == JumpVerdict::Change::kRaise || v.step == JumpVerdict::Change::kRaise) {
+      ++raised;
+      ADD_FAILURE() << "raised at " << t << " s: " << v.message;
+    }
+  }
+  EXPECT_EQ(raised, 0);
+}
+
 TEST(JumpCheck, TheRuddersSwingIsItsRangeOverTheWindowsAlsoWithRepeatedAngles) {
   // GIVEN a rudder sensor that prints whole degrees (long runs of equal angles) at 10 Hz:
   // the windows hold L + M = 10 + 5 samples
