@@ -418,16 +418,14 @@ JumpVerdict JumpCheck::decide(double t, double y, double delta, bool learn_ok) {
 
 void JumpCheck::integrate_rudder(double t, double delta) {
   // The rudder integral over every interval, once (the angle held over a missing one),
-  // whether or not this sample's y is usable. Once the interval is learned, a step is a
-  // whole number of intervals: the samples are taken as equally spaced (z's windows count
-  // samples), and the jitter of a stamp (a receive time) would otherwise move I by delta
-  // times it and z by b delta times it, in a hard turn more than the gyro's noise.
+  // whether or not this sample's y is usable. Once the interval is learned (dt_ > 0), a step
+  // is a whole number of intervals: the samples are taken as equally spaced (z's windows
+  // count samples), and the jitter of a stamp (a receive time) would otherwise move I by
+  // delta times it and z by b delta times it, in a hard turn more than the gyro's noise.
   const double d_now = std::isfinite(delta) ? delta : last_delta_;
   if (std::isfinite(int_t_) && std::isfinite(last_delta_) && std::isfinite(d_now)) {
-    double step = t - int_t_;
-    if (dt_seen_ >= kIntervalSamples && dt_ > 0) {
-      step = dt_ * static_cast<double>(std::max(1L, std::lround(step / dt_)));
-    }
+    const double gap = t - int_t_;
+    const double step = dt_ > 0 ? dt_ * static_cast<double>(intervals(gap)) : gap;
     I_ += 0.5 * (last_delta_ + d_now) * step;
   }
   int_t_ = t;
@@ -452,6 +450,8 @@ bool JumpCheck::learn_interval(double t) {
   return true;
 }
 
+long JumpCheck::intervals(double gap) const { return std::max(1L, std::lround(gap / dt_)); }
+
 bool JumpCheck::take_sample(double t, double y) {
   // A long gap restarts the windows (and the rudder integral, so z is computed after), as
   // does a rudder integral grown too large for its round-off.
@@ -463,7 +463,7 @@ bool JumpCheck::take_sample(double t, double y) {
   if (std::isfinite(last_t_)) {
     // Dropped samples: filled on the straight line between their neighbours.
     const double gap = t - last_t_;
-    const long steps = std::max(1L, std::lround(gap / dt_));
+    const long steps = intervals(gap);
     for (long j = 1; j < steps; ++j) {
       const double w = static_cast<double>(j) / static_cast<double>(steps);
       push(last_t_ + w * gap, last_z_ + w * (z - last_z_), last_I_ + w * (I_ - last_I_),

@@ -167,7 +167,6 @@ TEST(JumpCheck, StampJitterInAHardTurnIsNeitherANoiseRiseNorAJump) {
   JumpParams p;
   JumpCheck check(p, b, 1e-5);
   double I = 0.0, delta_prev = 0.0;
-  int raised = 0;
   for (long k = 0; k * h <= 360.0; ++k) {
     const double t = k * h;
     // (put over at 0.5 rad/s, held for 10 s, to the other side, ...)
@@ -186,11 +185,9 @@ TEST(JumpCheck, StampJitterInAHardTurnIsNeitherANoiseRiseNorAJump) {
     const JumpVerdict v = check.update(stamp, y, delta, !check.jump_raised());
     // THEN it raises neither a noise rise nor a jump
     if (v.noise == JumpVerdict::Change::kRaise || v.step == JumpVerdict::Change::kRaise) {
-      ++raised;
       ADD_FAILURE() << "raised at " << t << " s: " << v.message;
     }
   }
-  EXPECT_EQ(raised, 0);
 }
 
 TEST(JumpCheck, TheRuddersSwingIsItsRangeOverTheWindowsAlsoWithRepeatedAngles) {

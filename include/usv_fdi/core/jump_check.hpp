@@ -192,6 +192,9 @@ class JumpCheck {
   void integrate_rudder(double t, double delta);
   /// Learns the sample interval from the first samples; true once it is known.
   bool learn_interval(double t);
+  /// How many learned intervals a gap between two stamps spans (at least one); the interval
+  /// must be known.
+  long intervals(double gap) const;
   /// Puts z = y - b I (and the dropped samples before it) in the windows; true once they
   /// hold enough for the statistics.
   bool take_sample(double t, double y);
