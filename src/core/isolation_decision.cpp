@@ -174,6 +174,11 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
       } else {
         c.k = 2;  // both channels at once: the evidence singles out no sensor
       }
+      // The same channel again, soon after a raise that nothing held: the model's mismatch.
+      if (c.k < 2 && t - sens_[c.k].unheld_at <= p_.mismatch_window) {
+        c.repeated = c.k;
+        c.k = 2;
+      }
     }
   } else if (!u_res && a_res != g_res) {
     // One sensor raised: the other channel's structured residual is blind to its fault, so
@@ -209,12 +214,16 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
     if (k == 2) {
       // Model mismatch: a status with its reason, counted; never a latched sensor fault.
       char buf[160];
-      std::snprintf(buf, sizeof buf,
-                    "residuals of both channels (J_N %.3g / %.3g against %.3g / %.3g)%s", st_.J(0),
-                    st_.J(1), lv.thr(0), lv.thr(1),
-                    c.reclassify >= 0 ? c.reclassify == 0 ? " after an accelerometer raise"
-                                                          : " after a gyro raise"
-                                      : "");
+      std::snprintf(
+          buf, sizeof buf, "%s (J_N %.3g / %.3g against %.3g / %.3g)%s",
+          c.repeated >= 0 ? "residual of one channel again" : "residuals of both channels",
+          st_.J(0), st_.J(1), lv.thr(0), lv.thr(1),
+          c.reclassify >= 0
+              ? c.reclassify == 0 ? " after an accelerometer raise" : " after a gyro raise"
+          : c.repeated >= 0 ? c.repeated == 0 ? " soon after an accelerometer raise that "
+                                                "nothing held"
+                                              : " soon after a gyro raise that nothing held"
+                            : "");
       st_.model_mismatch = true;
       pending_stats_.clear();
       pending_drift_.clear();
@@ -269,6 +278,10 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
       if (std::isnan(sens_[k].below_since)) sens_[k].below_since = t;
       if (t - sens_[k].below_since + kEpsT >= p_.leave_time &&
           t - sens_[k].raised_at + kEpsT >= p_.min_active_time) {
+        // Cleared as soon as it could be: nothing held it (a residual raise only).
+        const bool unheld = k < 2 && sens_[k].cond.sources == kResidual &&
+                            t - sens_[k].raised_at <= p_.min_active_time + p_.leave_time + kEpsT;
+        if (unheld) sens_[k].unheld_at = t;
         set_condition(static_cast<Sensor>(k), kResidual, false, sens_[k].cond.kind, t,
                       "residual back below " + std::to_string(leave), out);
         sens_[k].below_since = kNaN;

@@ -71,7 +71,10 @@ struct IsolationParams {
   double second_fault_time = 2.0;
   /// Model mismatch, not a sensor fault: residuals on both channels at once (C_i singles
   /// out neither), or the other channel's structured residual rising within this long of a
-  /// raise (it is blind to the raised sensor's fault: the raise is withdrawn). Reported in
+  /// raise (it is blind to the raised sensor's fault: the raise is withdrawn), or a channel
+  /// rising again within this long of a raise that nothing held (cleared after
+  /// min_active_time + leave_time: neither its cross residual nor its monitor saw a fault,
+  /// as when a hull slows down and its rudder does less than B says). Reported in
   /// IsolatorStatus (model_mismatch, mismatch_reason, mismatches), never latched;
   /// identification goes on learning, and detection resumes once every statistic stayed
   /// below its leave threshold for leave_time [s]
@@ -273,6 +276,9 @@ class Isolator {
     double above_since = kNaN;  ///< its statistic above the enter threshold since
     double below_since = kNaN;  ///< ... below the leave threshold since
     double raised_at = kNaN;    ///< time of the residual raise
+    /// When a residual raise of this sensor last cleared as soon as it could, nothing (cross
+    /// residual, monitor) holding it: the model's mismatch, not a fault, if it comes back
+    double unheld_at = kNaN;
   };
 
   /// One pair of dedicated observers on one design of A, with the residual statistics
@@ -347,6 +353,7 @@ class Isolator {
   struct Candidate {
     int k = -1;
     int reclassify = -1;  ///< a raised sensor whose evidence turned out to be the model's
+    int repeated = -1;    ///< a sensor whose last raise nothing held, rising again
   };
   void propagate_observers(const Sample& s, double dt, bool v_ok, bool r_ok);
   void resync_observers(const Sample& s, bool v_ok, bool r_ok);
