@@ -162,6 +162,8 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
           t - mismatch_since_ + kEpsT >= p_.min_active_time) {
         st_.model_mismatch = false;
         st_.mismatch_reason.clear();
+        // A repeated rise's verdict keeps the suspicion on its channel going.
+        if (mismatch_repeated_ >= 0) sens_[mismatch_repeated_].unheld_at = t;
         below_mm_since_ = kNaN;
       }
     }
@@ -230,6 +232,7 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
       st_.mismatch_reason = buf;
       ++st_.mismatches;
       mismatch_since_ = t;
+      mismatch_repeated_ = c.repeated;
       below_mm_since_ = kNaN;
       if (c.reclassify >= 0) {
         chan_[c.reclassify].refine_at = kNaN;

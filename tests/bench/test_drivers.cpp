@@ -178,26 +178,28 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
   expect_no_raise(r);
 }
 
-TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismatch) {
-  // GIVEN the healthy first 1400 s of a proving-ground run of the nonlinear Otter (10 Hz, sea
-  // state 3, MEMS-grade sensors) whose voyage slows to half throttle after 900 s: B, given
-  // for full speed, overstates the rudder's effect about fourfold there, and the gyro
-  // channel's structured residual rises every 11-12 s. Up to stop 36 each rise raised a gyro
-  // fault that neither the cross residual nor the monitor held (cleared after
-  // min_active_time): 9 false gyro faults from 967 to 1064 s
-  EngineConfig engine_cfg;
-  const std::optional<Case> pick = proving_ground_run("otter @ 10 Hz", "voyage/sea3/mems",
-                                                      8068231856934621647ull, true, &engine_cfg);
-  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
-  ASSERT_GT(pick->fault.t_start, 1400.0);
-  const Stream data = pick->make();
-  // WHEN the engine with the shipped configuration replays it up to 1400 s
-  FdiEngine engine(engine_cfg);
-  std::vector<FaultEvent> events;
+/// What the engine with the shipped configuration does on the first 1400 s of a healthy
+/// stretch of a proving-ground run: its gyro raises after 900 s and its model-mismatch
+/// verdicts, with the first verdict's reason.
+struct SlowPassage {
   int gyro_raises = 0;
-  bool gyro_active = false;
   std::uint64_t mismatches = 0;
   std::string reason;
+};
+SlowPassage replay_slow_passage(std::uint64_t seed) {
+  SlowPassage out;
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick =
+      proving_ground_run("otter @ 10 Hz", "voyage/sea3/mems", seed, true, &engine_cfg);
+  if (!pick) {
+    ADD_FAILURE() << "the proving ground no longer has run " << seed;
+    return out;
+  }
+  EXPECT_GT(pick->fault.t_start, 1400.0);
+  const Stream data = pick->make();
+  FdiEngine engine(engine_cfg);
+  std::vector<FaultEvent> events;
+  bool gyro_active = false;
   for (const Sample& s : data.samples) {
     if (s.t > 1400.0) break;
     events.clear();
@@ -206,18 +208,35 @@ TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismat
       if (e.sensor != Sensor::kGyro) continue;
       const bool active =
           e.state == FaultState::kRaised || e.state == FaultState::kActiveAcknowledged;
-      if (active && !gyro_active && s.t > 900.0) ++gyro_raises;
+      if (active && !gyro_active && s.t > 900.0) ++out.gyro_raises;
       gyro_active = active;
     }
     const IsolatorStatus& st = engine.isolation_status();
-    if (st.mismatches > mismatches && reason.empty()) reason = st.mismatch_reason;
-    mismatches = st.mismatches;
+    if (st.mismatches > out.mismatches && out.reason.empty()) out.reason = st.mismatch_reason;
+    out.mismatches = st.mismatches;
   }
-  // THEN the slow passage raises the gyro at most once; its rises after that are reported as
-  // model mismatch, named so
-  EXPECT_LE(gyro_raises, 1);
-  EXPECT_GT(mismatches, 0u);
-  EXPECT_NE(reason.find("soon after a gyro raise that nothing held"), std::string::npos) << reason;
+  return out;
+}
+
+TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismatch) {
+  // GIVEN the healthy first 1400 s of two proving-ground runs of the nonlinear Otter (10 Hz,
+  // sea state 3, MEMS-grade sensors) whose voyage slows to half throttle after 900 s: B,
+  // given for full speed, overstates the rudder's effect about fourfold there, and the gyro
+  // channel's structured residual keeps rising. Up to stop 36 each rise raised a gyro fault
+  // that neither the cross residual nor the monitor held (cleared after min_active_time):
+  // 9 false gyro faults from 967 to 1064 s in the first, rises 11-12 s apart; in the second
+  // 4 from 956 to 1051 s, the later ones 15-17 s apart, after the first verdict had ended
+  for (const std::uint64_t seed : {8068231856934621647ull, 15453939662217126967ull}) {
+    SCOPED_TRACE(seed);
+    // WHEN the engine with the shipped configuration replays it up to 1400 s
+    const SlowPassage r = replay_slow_passage(seed);
+    // THEN the slow passage raises the gyro at most once; its rises after that are reported
+    // as model mismatch, named so
+    EXPECT_LE(r.gyro_raises, 1);
+    EXPECT_GT(r.mismatches, 0u);
+    EXPECT_NE(r.reason.find("soon after a gyro raise that nothing held"), std::string::npos)
+        << r.reason;
+  }
 }
 
 }  // namespace

@@ -74,7 +74,8 @@ struct IsolationParams {
   /// raise (it is blind to the raised sensor's fault: the raise is withdrawn), or a channel
   /// rising again within this long of a raise that nothing held (cleared after
   /// min_active_time + leave_time: neither its cross residual nor its monitor saw a fault,
-  /// as when a hull slows down and its rudder does less than B says). Reported in
+  /// as when a hull slows down and its rudder does less than B says) or of the end of such
+  /// a verdict of its own. Reported in
   /// IsolatorStatus (model_mismatch, mismatch_reason, mismatches), never latched;
   /// identification goes on learning, and detection resumes once every statistic stayed
   /// below its leave threshold for leave_time [s]
@@ -399,6 +400,7 @@ class Isolator {
   double t_armed_ = kNaN;
   double mismatch_since_ = kNaN;  ///< the current model-mismatch verdict began
   double below_mm_since_ = kNaN;  ///< ... and its statistics have been quiet since
+  int mismatch_repeated_ = -1;    ///< the verdict was a channel's repeated rise (Candidate)
   double settle_time_ = 0.0;
   double t_last_suspect_ = -1e300;
   double t_last_fault_ = -1e300;
