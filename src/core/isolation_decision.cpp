@@ -176,8 +176,11 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
       } else {
         c.k = 2;  // both channels at once: the evidence singles out no sensor
       }
-      // The same channel again, soon after a raise that nothing held: the model's mismatch.
-      if (c.k < 2 && t - sens_[c.k].unheld_at <= p_.mismatch_window) {
+      // The same channel again, its rise begun soon after a raise that nothing held (a rise
+      // that began in time stays one to its confirmation), and its cross residual showing
+      // no fault: the model's mismatch.
+      if (c.k < 2 && st_.D(c.k) <= lv.thr_exit_d(c.k) &&
+          (t - sens_[c.k].unheld_at <= p_.mismatch_window || repeat_rise_ == c.k)) {
         c.repeated = c.k;
         c.k = 2;
       }
@@ -197,6 +200,7 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
       }
     }
   }
+  repeat_rise_ = c.repeated;  // any other candidate (or none) ends the repeated rise
   return c;
 }
 
@@ -281,10 +285,12 @@ void Isolator::hold_or_clear(double t, const Levels& lv, int c, std::vector<Dete
       if (std::isnan(sens_[k].below_since)) sens_[k].below_since = t;
       if (t - sens_[k].below_since + kEpsT >= p_.leave_time &&
           t - sens_[k].raised_at + kEpsT >= p_.min_active_time) {
-        // Cleared as soon as it could be: nothing held it (a residual raise only).
+        // Cleared as soon as it could be: nothing held it (a residual raise only). The clear
+        // restarts the channel's observer, which settles for settle_time: the window for the
+        // channel's coming back counts from then.
         const bool unheld = k < 2 && sens_[k].cond.sources == kResidual &&
                             t - sens_[k].raised_at <= p_.min_active_time + p_.leave_time + kEpsT;
-        if (unheld) sens_[k].unheld_at = t;
+        if (unheld) sens_[k].unheld_at = t + settle_time_;
         set_condition(static_cast<Sensor>(k), kResidual, false, sens_[k].cond.kind, t,
                       "residual back below " + std::to_string(leave), out);
         sens_[k].below_since = kNaN;

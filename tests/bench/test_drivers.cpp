@@ -179,12 +179,12 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
 }
 
 /// What the engine with the shipped configuration does on the first 1400 s of a healthy
-/// stretch of a proving-ground run: its gyro raises after 900 s and its model-mismatch
-/// verdicts, with the first verdict's reason.
+/// stretch of a proving-ground run: its gyro raises and model-mismatch verdicts after 900 s,
+/// and the reasons of those verdicts.
 struct SlowPassage {
   int gyro_raises = 0;
-  std::uint64_t mismatches = 0;
-  std::string reason;
+  int mismatches = 0;
+  std::vector<std::string> reasons;
 };
 SlowPassage replay_slow_passage(std::uint64_t seed) {
   SlowPassage out;
@@ -200,6 +200,7 @@ SlowPassage replay_slow_passage(std::uint64_t seed) {
   FdiEngine engine(engine_cfg);
   std::vector<FaultEvent> events;
   bool gyro_active = false;
+  std::uint64_t seen = 0;
   for (const Sample& s : data.samples) {
     if (s.t > 1400.0) break;
     events.clear();
@@ -212,8 +213,11 @@ SlowPassage replay_slow_passage(std::uint64_t seed) {
       gyro_active = active;
     }
     const IsolatorStatus& st = engine.isolation_status();
-    if (st.mismatches > out.mismatches && out.reason.empty()) out.reason = st.mismatch_reason;
-    out.mismatches = st.mismatches;
+    if (st.mismatches > seen && s.t > 900.0) {
+      ++out.mismatches;
+      out.reasons.push_back(st.mismatch_reason);
+    }
+    seen = st.mismatches;
   }
   return out;
 }
@@ -233,9 +237,11 @@ TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismat
     // THEN the slow passage raises the gyro at most once; its rises after that are reported
     // as model mismatch, named so
     EXPECT_LE(r.gyro_raises, 1);
-    EXPECT_GT(r.mismatches, 0u);
-    EXPECT_NE(r.reason.find("soon after a gyro raise that nothing held"), std::string::npos)
-        << r.reason;
+    int repeats = 0;
+    for (const std::string& why : r.reasons) {
+      repeats += why.find("soon after a gyro raise that nothing held") != std::string::npos;
+    }
+    EXPECT_GT(repeats, 0) << r.mismatches << " verdicts after 900 s";
   }
 }
 

@@ -72,10 +72,12 @@ struct IsolationParams {
   /// Model mismatch, not a sensor fault: residuals on both channels at once (C_i singles
   /// out neither), or the other channel's structured residual rising within this long of a
   /// raise (it is blind to the raised sensor's fault: the raise is withdrawn), or a channel
-  /// rising again within this long of a raise that nothing held (cleared after
-  /// min_active_time + leave_time: neither its cross residual nor its monitor saw a fault,
-  /// as when a hull slows down and its rudder does less than B says) or of the end of such
-  /// a verdict of its own. Reported in
+  /// beginning to rise again within this long of being seen again after a raise of its own
+  /// that nothing held (cleared within min_active_time + leave_time of the raise: neither
+  /// its cross residual nor its monitor kept it, as when a hull slows down and its rudder
+  /// does less than B says; the clear restarts its observer, which settles for settle_time)
+  /// or of the end of such a verdict, its cross residual below its leave threshold.
+  /// Reported in
   /// IsolatorStatus (model_mismatch, mismatch_reason, mismatches), never latched;
   /// identification goes on learning, and detection resumes once every statistic stayed
   /// below its leave threshold for leave_time [s]
@@ -277,8 +279,10 @@ class Isolator {
     double above_since = kNaN;  ///< its statistic above the enter threshold since
     double below_since = kNaN;  ///< ... below the leave threshold since
     double raised_at = kNaN;    ///< time of the residual raise
-    /// When a residual raise of this sensor last cleared as soon as it could, nothing (cross
-    /// residual, monitor) holding it: the model's mismatch, not a fault, if it comes back
+    /// When the channel was seen again (its restarted observer settled) after a residual
+    /// raise of this sensor cleared within min_active_time + leave_time of the raise, nothing
+    /// (cross residual, monitor) holding it longer, or when a verdict of its repeated rise
+    /// ended: the model's mismatch, not a fault, if it comes back
     double unheld_at = kNaN;
   };
 
@@ -401,6 +405,7 @@ class Isolator {
   double mismatch_since_ = kNaN;  ///< the current model-mismatch verdict began
   double below_mm_since_ = kNaN;  ///< ... and its statistics have been quiet since
   int mismatch_repeated_ = -1;    ///< the verdict was a channel's repeated rise (Candidate)
+  int repeat_rise_ = -1;          ///< the candidate of the last sample was that repeated rise
   double settle_time_ = 0.0;
   double t_last_suspect_ = -1e300;
   double t_last_fault_ = -1e300;
