@@ -229,8 +229,8 @@ TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismat
   // channel's structured residual keeps rising. Up to stop 36 each rise raised a gyro fault
   // that neither the cross residual nor the monitor held (cleared after min_active_time):
   // 9 false gyro faults from 967 to 1064 s in the first, rises 11-12 s apart, and 8 from 956
-  // to 1074 s in the second (4 of them 15-17 s apart, after a first verdict had ended: the
-  // second run needs the chain)
+  // to 1074 s in the second (the rule without its chain left 4 there, the later ones 15-17 s
+  // apart, each after a verdict had ended)
   for (const std::uint64_t seed : {8068231856934621647ull, 15453939662217126967ull}) {
     SCOPED_TRACE(seed);
     // WHEN the engine with the shipped configuration replays it up to 1400 s
