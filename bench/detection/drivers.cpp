@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 namespace usvfdi::bench {
 
@@ -40,6 +41,18 @@ class ArmingClock {
   bool armed_before_ = false;
 };
 
+/// Each new model-mismatch verdict of the isolation stage, with its reason.
+class MismatchLog {
+ public:
+  void after_sample(double t, const IsolatorStatus& st, std::vector<MismatchVerdict>* out) {
+    if (st.mismatches > seen_) out->push_back(MismatchVerdict{t, st.mismatch_reason});
+    seen_ = st.mismatches;
+  }
+
+ private:
+  std::uint64_t seen_ = 0;
+};
+
 }  // namespace
 
 MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samples) {
@@ -47,6 +60,7 @@ MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samp
   FdiEngine engine(cfg);
   AlarmTracker tracker;
   ArmingClock clock;
+  MismatchLog verdicts;
   std::vector<FaultEvent> events;
   for (const Sample& s : samples) {
     events.clear();
@@ -61,6 +75,7 @@ MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samp
       }
     }
     clock.after_sample(s.t, engine.isolation_status(), &r.t_armed);
+    verdicts.after_sample(s.t, engine.isolation_status(), &r.mismatches);
   }
   r.A_final = engine.estimate().A;
   r.converged = engine.estimate().converged;
@@ -81,6 +96,7 @@ MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2
   est.excitation = 1.0;
   AlarmTracker tracker;
   ArmingClock clock;
+  MismatchLog verdicts;
   std::vector<Detection> dets;
   bool given = false;
   for (const Sample& s : samples) {
@@ -104,6 +120,7 @@ MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2
       given = true;
     }
     clock.after_sample(s.t, iso.status(), &r.t_armed);
+    verdicts.after_sample(s.t, iso.status(), &r.mismatches);
   }
   r.A_final = A;
   r.converged = true;

@@ -4,6 +4,7 @@
 // condition changes that scoring.hpp judges.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "scoring.hpp"
@@ -11,8 +12,15 @@
 
 namespace usvfdi::bench {
 
+/// A model-mismatch verdict of the isolation stage: when, and the reason it gave.
+struct MismatchVerdict {
+  double t = kNaN;
+  std::string reason;
+};
+
 struct MethodResult {
   std::vector<Alarm> alarms;
+  std::vector<MismatchVerdict> mismatches;  ///< in time order
   /// First sample at which detection was live (armed, settled, learned); NaN: never.
   double t_armed = kNaN;
   Mat2 A_final = Mat2::Zero();

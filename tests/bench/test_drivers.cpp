@@ -10,7 +10,6 @@
 
 #include "drivers.hpp"
 #include "runner.hpp"
-#include "usv_fdi/core/engine.hpp"
 #include "usv_fdi/core/simulator.hpp"
 #include "usv_fdi/core/vessel.hpp"
 
@@ -178,48 +177,23 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
   expect_no_raise(r);
 }
 
-/// What the engine with the shipped configuration does on the first 1400 s of a healthy
-/// stretch of a proving-ground run: its gyro raises and model-mismatch verdicts after 900 s,
-/// and the reasons of those verdicts.
-struct SlowPassage {
-  int gyro_raises = 0;
-  int mismatches = 0;
-  std::vector<std::string> reasons;
-};
-SlowPassage replay_slow_passage(std::uint64_t seed) {
-  SlowPassage out;
+/// The engine with the shipped configuration (as the proving ground runs it) on the healthy
+/// first 1400 s of a proving-ground run.
+MethodResult replay_slow_passage(std::uint64_t seed) {
   EngineConfig engine_cfg;
   const std::optional<Case> pick =
       proving_ground_run("otter @ 10 Hz", "voyage/sea3/mems", seed, true, &engine_cfg);
   if (!pick) {
     ADD_FAILURE() << "the proving ground no longer has run " << seed;
-    return out;
+    return {};
   }
   EXPECT_GT(pick->fault.t_start, 1400.0);
   const Stream data = pick->make();
-  FdiEngine engine(engine_cfg);
-  std::vector<FaultEvent> events;
-  bool gyro_active = false;
-  std::uint64_t seen = 0;
+  std::vector<Sample> first;
   for (const Sample& s : data.samples) {
-    if (s.t > 1400.0) break;
-    events.clear();
-    engine.process(s, &events);
-    for (const FaultEvent& e : events) {
-      if (e.sensor != Sensor::kGyro) continue;
-      const bool active =
-          e.state == FaultState::kRaised || e.state == FaultState::kActiveAcknowledged;
-      if (active && !gyro_active && s.t > 900.0) ++out.gyro_raises;
-      gyro_active = active;
-    }
-    const IsolatorStatus& st = engine.isolation_status();
-    if (st.mismatches > seen && s.t > 900.0) {
-      ++out.mismatches;
-      out.reasons.push_back(st.mismatch_reason);
-    }
-    seen = st.mismatches;
+    if (s.t <= 1400.0) first.push_back(s);
   }
-  return out;
+  return run_engine(engine_cfg, first);
 }
 
 TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismatch) {
@@ -234,15 +208,20 @@ TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismat
   for (const std::uint64_t seed : {8068231856934621647ull, 15453939662217126967ull}) {
     SCOPED_TRACE(seed);
     // WHEN the engine with the shipped configuration replays it up to 1400 s
-    const SlowPassage r = replay_slow_passage(seed);
+    const MethodResult r = replay_slow_passage(seed);
     // THEN the slow passage raises the gyro at most once; its rises after that are reported
     // as model mismatch, named so
-    EXPECT_LE(r.gyro_raises, 1);
-    int repeats = 0;
-    for (const std::string& why : r.reasons) {
-      repeats += why.find("soon after a gyro raise that nothing held") != std::string::npos;
+    int gyro_raises = 0, repeats = 0, verdicts = 0;
+    for (const Alarm& a : r.alarms) {
+      gyro_raises += a.raised && a.sensor == Sensor::kGyro && a.t > 900.0;
     }
-    EXPECT_GT(repeats, 0) << r.mismatches << " verdicts after 900 s";
+    for (const MismatchVerdict& m : r.mismatches) {
+      if (m.t <= 900.0) continue;
+      ++verdicts;
+      repeats += m.reason.find("soon after a gyro raise that nothing held") != std::string::npos;
+    }
+    EXPECT_LE(gyro_raises, 1);
+    EXPECT_GT(repeats, 0) << verdicts << " verdicts after 900 s";
   }
 }
 
