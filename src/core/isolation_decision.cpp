@@ -219,17 +219,18 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
     sens_[k].above_since = kNaN;
     if (k == 2) {
       // Model mismatch: a status with its reason, counted; never a latched sensor fault.
+      const char* after = "";
+      if (c.reclassify >= 0) {
+        after = c.reclassify == 0 ? " after an accelerometer raise" : " after a gyro raise";
+      } else if (c.repeated >= 0) {
+        after = c.repeated == 0 ? " soon after an accelerometer raise that nothing held"
+                                : " soon after a gyro raise that nothing held";
+      }
       char buf[160];
       std::snprintf(
           buf, sizeof buf, "%s (J_N %.3g / %.3g against %.3g / %.3g)%s",
           c.repeated >= 0 ? "residual of one channel again" : "residuals of both channels",
-          st_.J(0), st_.J(1), lv.thr(0), lv.thr(1),
-          c.reclassify >= 0
-              ? c.reclassify == 0 ? " after an accelerometer raise" : " after a gyro raise"
-          : c.repeated >= 0 ? c.repeated == 0 ? " soon after an accelerometer raise that "
-                                                "nothing held"
-                                              : " soon after a gyro raise that nothing held"
-                            : "");
+          st_.J(0), st_.J(1), lv.thr(0), lv.thr(1), after);
       st_.model_mismatch = true;
       pending_stats_.clear();
       pending_drift_.clear();

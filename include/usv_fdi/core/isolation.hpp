@@ -76,9 +76,8 @@ struct IsolationParams {
   /// that nothing held (cleared within min_active_time + leave_time of the raise: neither
   /// its cross residual nor its monitor kept it, as when a hull slows down and its rudder
   /// does less than B says; the clear restarts its observer, which settles for settle_time)
-  /// or of the end of such a verdict, its cross residual below its leave threshold.
-  /// Reported in
-  /// IsolatorStatus (model_mismatch, mismatch_reason, mismatches), never latched;
+  /// or of the end of such a verdict, its cross residual below its leave threshold. Reported
+  /// in IsolatorStatus (model_mismatch, mismatch_reason, mismatches), never latched;
   /// identification goes on learning, and detection resumes once every statistic stayed
   /// below its leave threshold for leave_time [s]
   double mismatch_window = 10.0;
