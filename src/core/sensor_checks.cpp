@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "usv_fdi/core/isolation.hpp"
 
@@ -46,21 +47,28 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
   prune(&ch.invalids, t - spike_window_);
   if (!missing && !absurd) {
     const bool repeat = x == ch.last_value;
+    // How often this channel repeats a value while it moves (its quantisation), learned per
+    // decade of |x| while it is not taken for stuck; a run's repeats once it has ended.
+    const double step = std::min(1.0, (t - ch.last_valid_t) / stuck_learn_time_);
     if (repeat) {
       if (ch.stuck_samples == 0) ch.stuck_since = ch.last_valid_t;
       ++ch.stuck_samples;
+      if (learn_repeat) {
+        ++ch.pending_repeats;
+        ch.pending_step += step;
+      }
     } else {
+      if (!ch.run_stuck) {
+        for (int i = 0; i < ch.pending_repeats; ++i) {
+          learn(&ch, ch.last_value, true, ch.pending_step / ch.pending_repeats);
+        }
+      }
+      ch.pending_repeats = 0;
+      ch.pending_step = 0.0;
+      ch.run_stuck = false;
       ch.stuck_samples = 0;
       ch.stuck_since = kNaN;
-    }
-    // How often this channel repeats a value while it moves (its quantisation), learned
-    // while it is not taken for stuck.
-    if (learn_repeat && std::isfinite(ch.last_value)) {
-      // The mean of the first samples, then an exponential average over stuck_learn_time.
-      ch.repeat_seen += 1.0;
-      const double w =
-          std::max(1.0 / ch.repeat_seen, std::min(1.0, (t - ch.last_valid_t) / stuck_learn_time_));
-      ch.repeat_fraction += w * ((repeat ? 1.0 : 0.0) - ch.repeat_fraction);
+      if (learn_repeat && std::isfinite(ch.last_value)) learn(&ch, x, false, step);
     }
     ch.last_value = x;
     ch.last_valid_t = t;
@@ -72,12 +80,47 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
   const double held = t - ch.stuck_since;  // NaN while the value moves
   v.stuck = false;
   if (ch.stuck_samples + 1 >= stuck_min_samples_ && held >= stuck_time_) {
-    // Repeats needed: a run this long is improbable for the channel as learned.
-    const double f = std::min(ch.repeat_fraction, 1.0 - 1e-12);
-    const double needed = f > 0.0 ? std::log(stuck_probability_) / std::log(f) : 0.0;
+    // Repeats needed: a run this long is improbable for the channel as learned at this value.
+    const double f = repeat_fraction(ch, ch.last_value);
+    double needed = std::numeric_limits<double>::infinity();  // rate unknown: not by repeats
+    if (f <= 0.0) {
+      needed = 0.0;
+    } else if (f > 0.0) {
+      needed = std::log(stuck_probability_) / std::log(std::min(f, 1.0 - 1e-12));
+    }
     v.stuck = ch.stuck_samples >= needed || held >= stuck_time_max_;
+    ch.run_stuck = ch.run_stuck || v.stuck;
   }
   v.invalid = static_cast<int>(ch.invalids.size()) >= invalid_count_;
+}
+
+void SensorChecks::learn(Channel* ch, double x, bool repeat, double step) {
+  // The mean of the first samples, then an exponential average over stuck_learn_time.
+  for (RepeatRate* rr : {&ch->repeat[decade(x)], &ch->pooled}) {
+    rr->seen += 1.0;
+    rr->fraction += std::max(1.0 / rr->seen, step) * ((repeat ? 1.0 : 0.0) - rr->fraction);
+  }
+}
+
+int SensorChecks::decade(double x) {
+  // floor(log10 |x|) by comparison (no log per sample), clamped; bin 0 below 10^kMinDecade.
+  static const std::array<double, kDecades - 1> kPowers = [] {
+    std::array<double, kDecades - 1> p{};
+    for (int i = 0; i < kDecades - 1; ++i) p[i] = std::pow(10.0, kMinDecade + i);
+    return p;
+  }();
+  const double a = std::abs(x);
+  int i = 0;
+  while (i < kDecades - 1 && a >= kPowers[i]) ++i;
+  return i;
+}
+
+double SensorChecks::repeat_fraction(const Channel& ch, double x) {
+  const RepeatRate& rr = ch.repeat[decade(x)];
+  if (rr.seen >= kRepeatLearned) return rr.fraction;
+  const bool full_precision =
+      ch.pooled.seen >= kRepeatLearned && ch.pooled.fraction <= kFullPrecision;
+  return full_precision ? ch.pooled.fraction : kNaN;
 }
 
 bool SensorChecks::timing_error(double t) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "usv_fdi/core/isolation.hpp"
@@ -62,6 +64,55 @@ TEST(SensorChecks, AQuantisedChannelThatMovesIsNotStuckButAFrozenOneIs) {
     stuck = f.checks.verdict(kInputV).stuck;
   }
   EXPECT_TRUE(stuck);
+}
+
+// v printed to 3 significant digits, as the proving ground's MEMS voyages print it.
+double three_digits(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return std::strtod(buf, nullptr);
+}
+
+TEST(SensorChecks, AChannelPrintedToSignificantDigitsIsJudgedByTheRateOfItsOwnDecade) {
+  // Below 1 m/s the quantum is 1 mm/s, a sixth of the noise, and values seldom repeat; above
+  // it the quantum is 1 cm/s and they repeat on about half of the samples. Learned over all
+  // decades at once, the first seconds above 1 m/s read as a frozen output (the proving
+  // ground's Mariner in its turns, "output frozen at 1.020000").
+  Feed f;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 0.006);
+  double t = 0.0;
+  bool ever_stuck = false;
+  const auto mean = [](double t) {
+    return t < 300.0 ? 0.6 + 0.2 * std::sin(0.02 * t) : std::min(1.03, 0.6 + 0.01 * (t - 300.0));
+  };
+  for (; t < 600.0; t += kDt) {
+    f.sample(t, three_digits(mean(t) + n(rng)));
+    ever_stuck = ever_stuck || f.checks.verdict(kInputV).stuck;
+  }
+  EXPECT_FALSE(ever_stuck);
+  // Frozen above 1 m/s, where the channel has moved long enough to learn its rate there:
+  // caught by the improbable run before stuck_time_max.
+  const IsolationParams p;
+  double stuck_at = NAN;
+  for (const double t0 = t; t < t0 + p.stuck_time_max + 0.5; t += kDt) {
+    f.sample(t, 1.02);
+    if (f.checks.verdict(kInputV).stuck && std::isnan(stuck_at)) stuck_at = t - t0;
+  }
+  ASSERT_FALSE(std::isnan(stuck_at));
+  EXPECT_LT(stuck_at, p.stuck_time_max - 1.0);
+  // Moving again below 1 m/s, then frozen there: caught within a second, by the rate of its
+  // own decade (a run of about 7 samples is improbable there; the rate over all decades, raised
+  // by the repeats above 1 m/s, needed 1.4 s).
+  for (const double t0 = t; t < t0 + 60.0; t += kDt) f.sample(t, three_digits(0.6 + n(rng)));
+  EXPECT_FALSE(f.checks.verdict(kInputV).stuck);
+  stuck_at = NAN;
+  for (const double t0 = t; t < t0 + 2.0; t += kDt) {
+    f.sample(t, 0.613);
+    if (f.checks.verdict(kInputV).stuck && std::isnan(stuck_at)) stuck_at = t - t0;
+  }
+  ASSERT_FALSE(std::isnan(stuck_at));
+  EXPECT_LT(stuck_at, 1.0);
 }
 
 TEST(SensorChecks, NoValidValueForStaleTimeoutIsStale) {

@@ -95,9 +95,10 @@ struct IsolationParams {
   int stuck_min_samples = 5;   ///< ... and for at least this many samples
   /// A quantised or coarsely printed channel (a yaw rate as NMEA ROT, v to 3 significant
   /// digits) repeats its value while it moves. The fraction f of samples that repeat the
-  /// previous one is learned (exponential average over stuck_learn_time, not while stuck),
-  /// and a channel is stuck only when its run of repeats is also longer than n samples with
-  /// f^n <= stuck_probability: improbable for the channel as it has been [-]
+  /// previous one is learned per decade of |x| (exponential average over stuck_learn_time, a
+  /// run's repeats once it has ended, not while stuck: SensorChecks), and a channel is stuck
+  /// only when its run of repeats is also longer than n samples with f^n <= stuck_probability:
+  /// improbable for the channel as it has been at that value [-]
   double stuck_probability = 1e-9;
   double stuck_learn_time = 60.0;  ///< averaging time of the repeat fraction [s]
   double stuck_time_max = 5.0;     ///< ... but unchanged this long is always stuck [s]

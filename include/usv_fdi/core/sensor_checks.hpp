@@ -47,16 +47,45 @@ class SensorChecks {
   bool timing_clear(double t);
 
  private:
+  /// How often a channel repeats its value, learned per decade of |x|: a channel printed to
+  /// a number of significant digits has a quantum that grows tenfold at each power of ten
+  /// (v to 3 digits: 0.001 below 1 m/s, 0.01 above), so it repeats itself far more often in
+  /// a decade above the ones it has moved in.
+  struct RepeatRate {
+    double fraction = 0.0;  ///< learned fraction of samples equal to the previous
+    double seen = 0;        ///< samples it was learned from (a plain mean at first)
+  };
+  /// Decades 10^kMinDecade .. 10^(kMinDecade + kDecades - 2) (clamped), the first bin below.
+  static constexpr int kMinDecade = -9;
+  static constexpr int kDecades = 14;
+  /// A decade's rate is used once it was learned from this many samples.
+  static constexpr double kRepeatLearned = 50;
+  /// A channel that repeats less often than this over all decades is taken as printed at full
+  /// precision: a decade it has not moved in is judged by that rate.
+  static constexpr double kFullPrecision = 1e-3;
+  static int decade(double x);
   struct Channel {
     double last_valid_t = kNaN;
     double last_value = kNaN;
     double stuck_since = kNaN;
     int stuck_samples = 0;
-    double repeat_fraction = 0.0;  ///< learned fraction of samples equal to the previous
-    double repeat_seen = 0;        ///< samples it was learned from (a plain mean at first)
-    std::deque<double> invalids;   ///< times of invalid values
+    std::array<RepeatRate, kDecades> repeat{};  ///< per decade of |x|
+    RepeatRate pooled;                          ///< over all decades
+    /// The current run's repeats, learned when it ends (a run is judged by the rates from
+    /// before it) and only if it was never taken for stuck.
+    int pending_repeats = 0;
+    double pending_step = 0.0;  ///< their summed weights (sample interval / stuck_learn_time)
+    bool run_stuck = false;
+    std::deque<double> invalids;  ///< times of invalid values
   };
+  /// The repeat fraction to judge a run at x by: its decade's once learned; before that, the
+  /// rate over all decades of a channel learned to be at full precision, and NaN otherwise (a
+  /// quantised channel's rate in a decade it has not moved in is unknown, and so is any rate
+  /// before kRepeatLearned samples: only stuck_time_max then holds).
+  static double repeat_fraction(const Channel& ch, double x);
   void check(int c, double t, double x, double limit, bool learn_repeat, InputHealth* input);
+  /// One learned sample (repeat or not) at x, of weight step, into its decade and the pool.
+  static void learn(Channel* ch, double x, bool repeat, double step);
 
   double stale_timeout_, stuck_time_, stuck_probability_, stuck_learn_time_, stuck_time_max_;
   int stuck_min_samples_, invalid_count_;
