@@ -76,7 +76,10 @@ MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samp
     }
     clock.after_sample(s.t, engine.isolation_status(), &r.t_armed);
     verdicts.after_sample(s.t, engine.isolation_status(), &r.mismatches);
+    ++r.samples;
+    if (engine.estimate().frozen) ++r.frozen_samples;
   }
+  r.has_identification = true;
   r.A_final = engine.estimate().A;
   r.converged = engine.estimate().converged;
   return r;
@@ -121,6 +124,7 @@ MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2
     }
     clock.after_sample(s.t, iso.status(), &r.t_armed);
     verdicts.after_sample(s.t, iso.status(), &r.mismatches);
+    ++r.samples;
   }
   r.A_final = A;
   r.converged = true;

@@ -25,7 +25,11 @@ struct MethodResult {
   double t_armed = kNaN;
   Mat2 A_final = Mat2::Zero();
   bool converged = false;  ///< the estimate said so at the end
-  RunScore score;          ///< filled by the caller (run_case) from the alarms
+  /// Samples of the run, and those on which identification was frozen (the estimate said so;
+  /// the oracle has no identification: has_identification false).
+  std::size_t samples = 0, frozen_samples = 0;
+  bool has_identification = false;
+  RunScore score;  ///< filled by the caller (run_case) from the alarms
 };
 
 /// The oracle: the engine's isolation stage (Isolator + FaultLatch, default IsolationParams)

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
 #include <tuple>
 
 #include "runner.hpp"
@@ -67,7 +68,10 @@ void write_method_summary(std::ostream& o, const MethodSummary& m) {
     << ", \"armed_runs\": " << m.armed_runs << ", \"arming_median\": " << json_num(m.arming_median)
     << ", \"arming_max\": " << json_num(m.arming_max)
     << ", \"a_error_median\": " << json_num(m.a_error_median)
-    << ", \"a_error_p95\": " << json_num(m.a_error_p95) << ", \"per_kind\": {";
+    << ", \"a_error_p95\": " << json_num(m.a_error_p95)
+    << ", \"healthy_run_hours\": " << json_num(m.healthy_run_hours)
+    << ", \"healthy_run_mismatches\": " << m.healthy_run_mismatches
+    << ", \"healthy_run_frozen_share\": " << json_num(m.frozen_share()) << ", \"per_kind\": {";
   for (std::size_t i = 0; i < standard_kinds().size(); ++i) {
     o << (i ? ", " : "") << json_str(to_string(standard_kinds()[i])) << ": [" << m.per_kind[i][0]
       << ", " << m.per_kind[i][1] << ", " << m.per_kind[i][2] << "]";
@@ -94,7 +98,9 @@ void write_method_result(std::ostream& o, const Case& c, const MethodResult& m) 
     << ", \"a_error\": " << json_num(ref > 0 ? (m.A_final - c.A_ref).norm() / ref : kNaN)
     << ", \"A_final\": [" << json_num(m.A_final(0, 0)) << ", " << json_num(m.A_final(0, 1)) << ", "
     << json_num(m.A_final(1, 0)) << ", " << json_num(m.A_final(1, 1)) << "]"
-    << ", \"healthy_s\": " << json_num(m.score.healthy_time) << ", \"false_alarms\": [";
+    << ", \"healthy_s\": " << json_num(m.score.healthy_time) << ", \"frozen_samples\": "
+    << (m.has_identification ? std::to_string(m.frozen_samples) : "null")
+    << ", \"mismatches\": " << m.mismatches.size() << ", \"false_alarms\": [";
   for (std::size_t j = 0; j < m.score.false_alarm_events.size(); ++j) {
     const Alarm& a = m.score.false_alarm_events[j];
     o << (j ? ", " : "") << "[" << json_num(a.t) << ", " << json_str(to_string(a.sensor)) << ", "
@@ -275,6 +281,23 @@ std::string to_markdown(const std::vector<TableSummary>& tables, const std::stri
         << m.recovered << "/" << m.detected << ") | " << m.armed_runs << "/" << m.runs << " | "
         << fmt("%.0f", m.arming_median) << " / " << fmt("%.0f", m.arming_max) << " | "
         << fmt("%.3f", m.a_error_median) << " / " << fmt("%.3f", m.a_error_p95) << " |\n";
+    }
+    if (t.m[kEngine].healthy_run_hours > 0) {
+      o << "\nOn the healthy runs (" << fmt("%.1f", t.m[kEngine].healthy_run_hours)
+        << " h): model-mismatch verdicts per hour";
+      for (int k = 0; k < kMethods; ++k) {
+        o << (k ? ", " : " ") << method_name(k) << " " << fmt("%.2f", t.m[k].mismatches_per_hour())
+          << " (" << t.m[k].healthy_run_mismatches << ")";
+      }
+      o << "; identification frozen on";
+      bool first = true;
+      for (int k = 0; k < kMethods; ++k) {
+        if (!t.m[k].has_identification) continue;
+        o << (first ? " " : " / ") << fmt("%.1f %%", 100.0 * t.m[k].frozen_share()) << " ("
+          << method_name(k) << ")";
+        first = false;
+      }
+      o << " of the samples.\n";
     }
     bool any = false;
     for (const MethodSummary& m : t.m) any = any || m.faults > 0;

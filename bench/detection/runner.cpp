@@ -606,6 +606,13 @@ void add_method_run(const Case& c, const CaseResult& r, const MethodResult& mr, 
   }
   m->healthy_hours += mr.score.healthy_time / 3600.0;
   m->healthy_armed_hours += mr.score.healthy_armed_time / 3600.0;
+  m->has_identification = mr.has_identification;
+  if (!c.faulty) {
+    m->healthy_run_hours += (r.t_last - r.t_first) / 3600.0;
+    m->healthy_run_mismatches += static_cast<int>(mr.mismatches.size());
+    m->healthy_run_samples += mr.samples;
+    m->healthy_run_frozen += mr.frozen_samples;
+  }
   add_fault_scores(mr.score.faults, m, a);
 }
 

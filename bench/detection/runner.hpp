@@ -140,6 +140,20 @@ struct MethodSummary {
   double a_error_median = kNaN, a_error_p95 = kNaN;  ///< ||A^ - A||_F / ||A||_F at the end
   std::vector<std::array<int, 3>> per_kind;  ///< faults, detected, isolated per standard kind
   int false_alarms_armed = 0;                ///< those raised after arming
+  /// The runs without a fault: their hours, the model-mismatch verdicts given on them, and
+  /// the share of their samples on which identification was frozen (NaN: no identification).
+  double healthy_run_hours = 0.0;
+  int healthy_run_mismatches = 0;
+  std::size_t healthy_run_samples = 0, healthy_run_frozen = 0;
+  bool has_identification = false;
+  double frozen_share() const {
+    return has_identification && healthy_run_samples > 0
+               ? static_cast<double>(healthy_run_frozen) / healthy_run_samples
+               : kNaN;
+  }
+  double mismatches_per_hour() const {
+    return healthy_run_hours > 0 ? healthy_run_mismatches / healthy_run_hours : kNaN;
+  }
   double fa_per_hour() const { return healthy_hours > 0 ? false_alarms / healthy_hours : kNaN; }
   double fa_per_armed_hour() const {
     return healthy_armed_hours > 0 ? false_alarms_armed / healthy_armed_hours : kNaN;

@@ -93,6 +93,31 @@ TEST(BenchQuick, HarnessWorksAndTheOracleDetectsTheFaults) {
       if (m.armed_runs > 0) {
         EXPECT_LE(m.arming_median, m.arming_max);
       }
+      // The healthy runs' suspicion measures: their hours are the healthy runs' spans; the
+      // share of frozen samples exists for the methods that identify, within [0, 1].
+      double healthy_run_hours = 0.0;
+      std::size_t samples = 0, frozen = 0, verdicts = 0;
+      for (const CaseResult& r : results) {
+        const Case& c = cases[r.index];
+        if (c.table != t.name || c.faulty) continue;
+        healthy_run_hours += (r.t_last - r.t_first) / 3600.0;
+        samples += r.m[k].samples;
+        frozen += r.m[k].frozen_samples;
+        verdicts += r.m[k].mismatches.size();
+        EXPECT_EQ(r.m[k].samples, r.samples);
+      }
+      EXPECT_NEAR(m.healthy_run_hours, healthy_run_hours, 1e-9);
+      EXPECT_EQ(m.healthy_run_samples, samples);
+      EXPECT_EQ(static_cast<std::size_t>(m.healthy_run_mismatches), verdicts);
+      if (k == kOracle) {
+        EXPECT_FALSE(m.has_identification);
+        EXPECT_TRUE(std::isnan(m.frozen_share()));
+      } else {
+        EXPECT_TRUE(m.has_identification);
+        EXPECT_GE(m.frozen_share(), 0.0);
+        EXPECT_LE(m.frozen_share(), 1.0);
+        EXPECT_EQ(m.healthy_run_frozen, frozen);
+      }
     }
     // The oracle knows A: zero error, armed on every run (after settling and learning).
     const MethodSummary& o = t.m[kOracle];
