@@ -19,7 +19,7 @@ SensorChecks::SensorChecks(const IsolationParams& p)
     : stale_timeout_(p.stale_timeout),
       stuck_time_(p.stuck_time),
       stuck_probability_(p.stuck_probability),
-      stuck_learn_time_(p.stuck_learn_time),
+      inv_learn_time_(1.0 / p.stuck_learn_time),
       stuck_time_max_(p.stuck_time_max),
       stuck_min_samples_(p.stuck_min_samples),
       invalid_count_(p.invalid_count),
@@ -49,7 +49,7 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
     const bool repeat = x == ch.last_value;
     // How often this channel repeats a value while it moves (its quantisation), learned per
     // decade of |x| while it is not taken for stuck; a run's repeats once it has ended.
-    const double step = std::min(1.0, (t - ch.last_valid_t) / stuck_learn_time_);
+    const double step = std::min(1.0, (t - ch.last_valid_t) * inv_learn_time_);
     if (repeat) {
       if (ch.stuck_samples == 0) ch.stuck_since = ch.last_valid_t;
       ++ch.stuck_samples;
@@ -58,10 +58,9 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
         ch.pending_step += step;
       }
     } else {
-      if (!ch.run_stuck) {
-        for (int i = 0; i < ch.pending_repeats; ++i) {
-          learn(&ch, ch.last_value, true, ch.pending_step / ch.pending_repeats);
-        }
+      if (!ch.run_stuck && ch.pending_repeats > 0) {
+        const double mean_step = ch.pending_step / ch.pending_repeats;
+        for (int i = 0; i < ch.pending_repeats; ++i) learn(&ch, ch.last_value, true, mean_step);
       }
       ch.pending_repeats = 0;
       ch.pending_step = 0.0;
@@ -81,7 +80,7 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
   v.stuck = false;
   if (ch.stuck_samples + 1 >= stuck_min_samples_ && held >= stuck_time_) {
     // Repeats needed: a run this long is improbable for the channel as learned at this value.
-    const double f = repeat_fraction(ch, ch.last_value);
+    const double f = repeat_fraction(&ch, ch.last_value);
     double needed = std::numeric_limits<double>::infinity();  // rate unknown: not by repeats
     if (f <= 0.0) {
       needed = 0.0;
@@ -96,31 +95,34 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
 
 void SensorChecks::learn(Channel* ch, double x, bool repeat, double step) {
   // The mean of the first samples, then an exponential average over stuck_learn_time.
-  for (RepeatRate* rr : {&ch->repeat[decade(x)], &ch->pooled}) {
+  ch->last_decade = decade(x, ch->last_decade);
+  for (RepeatRate* rr : {&ch->repeat[ch->last_decade], &ch->pooled}) {
     rr->seen += 1.0;
-    rr->fraction += std::max(1.0 / rr->seen, step) * ((repeat ? 1.0 : 0.0) - rr->fraction);
+    // max(1 / seen, step), dividing only while the plain mean lasts.
+    const double w = rr->seen * step >= 1.0 ? step : 1.0 / rr->seen;
+    rr->fraction += w * ((repeat ? 1.0 : 0.0) - rr->fraction);
   }
 }
 
-int SensorChecks::decade(double x) {
-  // floor(log10 |x|) by comparison (no log per sample), clamped; bin 0 below 10^kMinDecade.
-  static const std::array<double, kDecades - 1> kPowers = [] {
-    std::array<double, kDecades - 1> p{};
-    for (int i = 0; i < kDecades - 1; ++i) p[i] = std::pow(10.0, kMinDecade + i);
-    return p;
-  }();
+int SensorChecks::decade(double x, int hint) {
+  // floor(log10 |x|) by comparison from the hint (no log per sample), clamped.
+  static constexpr double kPowers[kDecades - 1] = {1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3,
+                                                   1e-2, 1e-1, 1e0,  1e1,  1e2,  1e3};
+  static_assert(kMinDecade == -9 && kDecades == 14, "kPowers lists 10^kMinDecade and up");
   const double a = std::abs(x);
-  int i = 0;
+  int i = std::min(std::max(hint, 0), kDecades - 1);
+  while (i > 0 && a < kPowers[i - 1]) --i;
   while (i < kDecades - 1 && a >= kPowers[i]) ++i;
   return i;
 }
 
-double SensorChecks::repeat_fraction(const Channel& ch, double x) {
-  const RepeatRate& rr = ch.repeat[decade(x)];
+double SensorChecks::repeat_fraction(Channel* ch, double x) {
+  ch->last_decade = decade(x, ch->last_decade);
+  const RepeatRate& rr = ch->repeat[ch->last_decade];
   if (rr.seen >= kRepeatLearned) return rr.fraction;
   const bool full_precision =
-      ch.pooled.seen >= kRepeatLearned && ch.pooled.fraction <= kFullPrecision;
-  return full_precision ? ch.pooled.fraction : kNaN;
+      ch->pooled.seen >= kRepeatLearned && ch->pooled.fraction <= kFullPrecision;
+  return full_precision ? ch->pooled.fraction : kNaN;
 }
 
 bool SensorChecks::timing_error(double t) {

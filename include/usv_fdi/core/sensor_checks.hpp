@@ -63,7 +63,10 @@ class SensorChecks {
   /// A channel that repeats less often than this over all decades is taken as printed at full
   /// precision: a decade it has not moved in is judged by that rate.
   static constexpr double kFullPrecision = 1e-3;
-  static int decade(double x);
+  /// The bin of |x|: 0 below 10^kMinDecade, i for 10^(kMinDecade + i - 1) <= |x| <
+  /// 10^(kMinDecade + i), the last bin unbounded. Searched from hint (the channel's last bin:
+  /// a signal seldom leaves its decade between samples).
+  static int decade(double x, int hint);
   struct Channel {
     double last_valid_t = kNaN;
     double last_value = kNaN;
@@ -71,6 +74,7 @@ class SensorChecks {
     int stuck_samples = 0;
     std::array<RepeatRate, kDecades> repeat{};  ///< per decade of |x|
     RepeatRate pooled;                          ///< over all decades
+    int last_decade = 0;                        ///< decade() of the last value looked up
     /// The current run's repeats, learned when it ends (a run is judged by the rates from
     /// before it) and only if it was never taken for stuck.
     int pending_repeats = 0;
@@ -82,12 +86,14 @@ class SensorChecks {
   /// rate over all decades of a channel learned to be at full precision, and NaN otherwise (a
   /// quantised channel's rate in a decade it has not moved in is unknown, and so is any rate
   /// before kRepeatLearned samples: only stuck_time_max then holds).
-  static double repeat_fraction(const Channel& ch, double x);
+  static double repeat_fraction(Channel* ch, double x);
   void check(int c, double t, double x, double limit, bool learn_repeat, InputHealth* input);
   /// One learned sample (repeat or not) at x, of weight step, into its decade and the pool.
   static void learn(Channel* ch, double x, bool repeat, double step);
 
-  double stale_timeout_, stuck_time_, stuck_probability_, stuck_learn_time_, stuck_time_max_;
+  double stale_timeout_, stuck_time_, stuck_probability_;
+  double inv_learn_time_;  ///< 1 / stuck_learn_time (a product per sample, not a quotient)
+  double stuck_time_max_;
   int stuck_min_samples_, invalid_count_;
   double spike_window_;
   std::array<double, 3> limits_;
