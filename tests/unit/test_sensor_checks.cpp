@@ -18,8 +18,29 @@ constexpr double kDt = 0.1;
 struct Feed {
   SensorChecks checks{IsolationParams{}};
   InputHealth input;
+  double t = 0.0;  ///< the next sample's time, for move_v and hold_v
   void sample(double t, double v, double r = 0.0, double delta = 0.0) {
     checks.update(Sample{t, v, r, delta}, {true, true}, &input);
+  }
+  /// v = value(t) every kDt for span seconds; whether v was ever taken for stuck.
+  template <class F>
+  bool move_v(double span, F value) {
+    bool ever_stuck = false;
+    for (const double t0 = t; t < t0 + span; t += kDt) {
+      sample(t, value(t));
+      ever_stuck = ever_stuck || checks.verdict(kInputV).stuck;
+    }
+    return ever_stuck;
+  }
+  /// v held at value every kDt for span seconds; how long after the first of them v was first
+  /// taken for stuck (NaN: never).
+  double hold_v(double value, double span) {
+    double stuck_at = NAN;
+    for (const double t0 = t; t < t0 + span; t += kDt) {
+      sample(t, value);
+      if (checks.verdict(kInputV).stuck && std::isnan(stuck_at)) stuck_at = t - t0;
+    }
+    return stuck_at;
   }
 };
 
@@ -50,20 +71,12 @@ TEST(SensorChecks, AQuantisedChannelThatMovesIsNotStuckButAFrozenOneIs) {
   Feed f;
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0.0, 0.005);
-  double t = 0.0;
-  bool ever_stuck = false;
-  for (; t < 600.0; t += kDt) {
-    f.sample(t, std::round(100.0 * (0.05 * std::sin(0.05 * t) + n(rng))) / 100.0);
-    ever_stuck = ever_stuck || f.checks.verdict(kInputV).stuck;
-  }
-  EXPECT_FALSE(ever_stuck);
+  EXPECT_FALSE(f.move_v(600.0, [&](double t) {
+    return std::round(100.0 * (0.05 * std::sin(0.05 * t) + n(rng))) / 100.0;
+  }));
   // Frozen: caught at the latest after stuck_time_max.
-  bool stuck = false;
-  for (const double t0 = t; t < t0 + IsolationParams{}.stuck_time_max + 0.5; t += kDt) {
-    f.sample(t, 0.42);
-    stuck = f.checks.verdict(kInputV).stuck;
-  }
-  EXPECT_TRUE(stuck);
+  f.hold_v(0.42, IsolationParams{}.stuck_time_max + 0.5);
+  EXPECT_TRUE(f.checks.verdict(kInputV).stuck);
 }
 
 // v printed to 3 significant digits, as the proving ground's MEMS voyages print it.
@@ -81,36 +94,22 @@ TEST(SensorChecks, AChannelPrintedToSignificantDigitsIsJudgedByTheRateOfItsOwnDe
   Feed f;
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0.0, 0.006);
-  double t = 0.0;
-  bool ever_stuck = false;
   const auto mean = [](double t) {
     return t < 300.0 ? 0.6 + 0.2 * std::sin(0.02 * t) : std::min(1.03, 0.6 + 0.01 * (t - 300.0));
   };
-  for (; t < 600.0; t += kDt) {
-    f.sample(t, three_digits(mean(t) + n(rng)));
-    ever_stuck = ever_stuck || f.checks.verdict(kInputV).stuck;
-  }
-  EXPECT_FALSE(ever_stuck);
+  EXPECT_FALSE(f.move_v(600.0, [&](double t) { return three_digits(mean(t) + n(rng)); }));
   // Frozen above 1 m/s, where the channel has moved long enough to learn its rate there:
   // caught by the improbable run before stuck_time_max.
   const IsolationParams p;
-  double stuck_at = NAN;
-  for (const double t0 = t; t < t0 + p.stuck_time_max + 0.5; t += kDt) {
-    f.sample(t, 1.02);
-    if (f.checks.verdict(kInputV).stuck && std::isnan(stuck_at)) stuck_at = t - t0;
-  }
+  double stuck_at = f.hold_v(1.02, p.stuck_time_max + 0.5);
   ASSERT_FALSE(std::isnan(stuck_at));
   EXPECT_LT(stuck_at, p.stuck_time_max - 1.0);
   // Moving again below 1 m/s, then frozen there: caught within a second, by the rate of its
   // own decade (a run of about 7 samples is improbable there; the rate over all decades, raised
   // by the repeats above 1 m/s, needed 1.4 s).
-  for (const double t0 = t; t < t0 + 60.0; t += kDt) f.sample(t, three_digits(0.6 + n(rng)));
+  f.move_v(60.0, [&](double) { return three_digits(0.6 + n(rng)); });
   EXPECT_FALSE(f.checks.verdict(kInputV).stuck);
-  stuck_at = NAN;
-  for (const double t0 = t; t < t0 + 2.0; t += kDt) {
-    f.sample(t, 0.613);
-    if (f.checks.verdict(kInputV).stuck && std::isnan(stuck_at)) stuck_at = t - t0;
-  }
+  stuck_at = f.hold_v(0.613, 2.0);
   ASSERT_FALSE(std::isnan(stuck_at));
   EXPECT_LT(stuck_at, 1.0);
 }
