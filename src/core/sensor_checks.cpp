@@ -81,9 +81,9 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
   if (ch.stuck_samples + 1 >= stuck_min_samples_ && held >= stuck_time_) {
     // Repeats needed: a run this long is improbable for the channel as learned at this value.
     const double f = repeat_fraction(&ch, ch.last_value);
-    double needed = std::numeric_limits<double>::infinity();  // rate unknown: not by repeats
-    if (f <= 0.0) {
-      needed = 0.0;
+    double needed = 0.0;
+    if (std::isnan(f)) {
+      needed = std::numeric_limits<double>::infinity();  // rate unknown: not by repeats
     } else if (f > 0.0) {
       needed = std::log(stuck_probability_) / std::log(std::min(f, 1.0 - 1e-12));
     }
