@@ -130,7 +130,16 @@ test('a sidecar\'s faults on the board: raise, late browser, acknowledge, observ
   // and the accelerometer's, then both clear
   await page.waitForSelector(`${cell(mmsi, 'accelerometer')}[data-state="raised"]`, { timeout: 90000 });
   assert.equal(await sim.exited, 0, readLog(sim));
-  await page.waitForSelector(`${cell(mmsi, 'accelerometer')}[data-sequence="2"]`, { timeout: 30000 });
+  await page.waitForSelector('#events tbody tr[data-sensor="accelerometer"][data-sequence="2"]',
+                             { timeout: 30000 });
+  // AND once the simulator has stopped, both INS channels are raised stale (#3) an input_timeout
+  // later; nothing changes after that until an acknowledgement. (Waited for here: a late page
+  // compared with a board that has not drawn them yet would wait for a state that is gone.)
+  for (const s of ['gyro', 'accelerometer']) {
+    await page.waitForSelector(`${cell(mmsi, s)}[data-state="raised"][data-sequence="3"]`,
+                               { timeout: 30000 });
+  }
+  assert.match(await page.textContent(`${cell(mmsi, 'gyro')} .detail`), /stale/);
   await page.screenshot({ path: path.join(out, 'board.png'), fullPage: true });
   // The event list has every event, newest first, and filters by sensor.
   const seqs = await page.$$eval('#events tbody tr', (rows) => rows.map((r) => r.dataset.sensor + r.dataset.sequence));
@@ -143,10 +152,10 @@ test('a sidecar\'s faults on the board: raise, late browser, acknowledge, observ
   const late = await newPage();
   const t0 = Date.now();
   await late.goto(dash.url);
-  const gyroState = await page.getAttribute(cell(mmsi, 'gyro'), 'data-state');
   // (A generous bound: on a machine busy with other tests the page can take seconds to load;
   // the time it took is printed.)
-  await late.waitForSelector(`${cell(mmsi, 'gyro')}[data-state="${gyroState}"]`, { timeout: 30000 });
+  await late.waitForSelector(`${cell(mmsi, 'gyro')}[data-state="raised"][data-sequence="3"]`,
+                             { timeout: 30000 });
   console.log(`late browser had the latched state after ${(Date.now() - t0) / 1000} s`);
 
   // WHEN the operator acknowledges the gyro's event with the button
