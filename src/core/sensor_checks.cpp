@@ -46,10 +46,14 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
   }
   prune(&ch.invalids, t - spike_window_);
   if (!missing && !absurd) {
-    const bool repeat = x == ch.last_value;
+    // After a gap longer than stale_timeout the value is no repeat of the one before it, and
+    // the pair teaches nothing: the stream says nothing of what the channel did in between.
+    const double gap = t - ch.last_valid_t;
+    const bool after_gap = gap > stale_timeout_;
+    const bool repeat = !after_gap && x == ch.last_value;
     // How often this channel repeats a value while it moves (its quantisation), learned per
     // decade of |x| while it is not taken for stuck; a run's repeats once it has ended.
-    const double step = std::min(1.0, (t - ch.last_valid_t) * inv_learn_time_);
+    const double step = std::min(1.0, gap * inv_learn_time_);
     if (repeat) {
       if (ch.stuck_samples == 0) ch.stuck_since = ch.last_valid_t;
       ++ch.stuck_samples;
@@ -67,7 +71,7 @@ void SensorChecks::check(int c, double t, double x, double limit, bool learn_rep
       ch.run_stuck = false;
       ch.stuck_samples = 0;
       ch.stuck_since = kNaN;
-      if (learn_repeat && std::isfinite(ch.last_value)) learn(&ch, x, false, step);
+      if (learn_repeat && !after_gap && std::isfinite(ch.last_value)) learn(&ch, x, false, step);
     }
     ch.last_value = x;
     ch.last_valid_t = t;

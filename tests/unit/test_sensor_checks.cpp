@@ -114,6 +114,28 @@ TEST(SensorChecks, AChannelPrintedToSignificantDigitsIsJudgedByTheRateOfItsOwnDe
   EXPECT_LT(stuck_at, 1.0);
 }
 
+TEST(SensorChecks, AGapInTheStreamNeitherTeachesTheRateNorHoldsTheValue) {
+  // A quantised channel that repeats on about half of its samples, then two minutes without a
+  // sample (a recording paused, a link down). The gap says nothing about how the channel
+  // repeats, and its first value after the gap is no repeat of the last one before: moving
+  // again, it is not taken for stuck.
+  Feed f;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 0.005);
+  const auto quantised = [&](double t) {
+    return std::round(100.0 * (0.05 * std::sin(0.05 * t) + n(rng))) / 100.0;
+  };
+  ASSERT_FALSE(f.move_v(600.0, quantised));
+  const double before_gap = f.checks.verdict(kInputV).value;
+  f.t += 120.0;
+  // resuming at the value it stopped at, for a few samples, then moving again
+  EXPECT_TRUE(std::isnan(f.hold_v(before_gap, 0.45)));
+  EXPECT_FALSE(f.move_v(120.0, quantised));
+  // still caught when frozen
+  f.hold_v(0.42, IsolationParams{}.stuck_time_max + 0.5);
+  EXPECT_TRUE(f.checks.verdict(kInputV).stuck);
+}
+
 TEST(SensorChecks, NoValidValueForStaleTimeoutIsStale) {
   Feed f;
   f.sample(0.0, 0.1);
