@@ -386,10 +386,14 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   const bool r_ok = within(s.r, p_.max_abs_r);
   if (have_prev_ && dt > 0) propagate_observers(s, dt, v_ok, r_ok);
   resync_observers(s, v_ok, r_ok);
-  const bool learn_ok = healthy_for_learning(s.t, v_ok, r_ok);
+  // The maxima the bars follow learn through a model-mismatch verdict too, the scales and the
+  // rest not: a manoeuvre the model does not hold, kept out of the maxima, met the same bar
+  // the next time and was raised or judged again (the Otter's course changes, every 20 s).
+  const bool maxima_ok = healthy_for_maxima(s.t, v_ok, r_ok);
+  const bool learn_ok = maxima_ok && !st_.model_mismatch;
   Statistics x;
   if (!evaluate_banks(s, dt, learn_ok, v_ok, r_ok, &x)) return;
-  record_statistics(s.t, x, learn_ok);
+  record_statistics(s.t, x, maxima_ok);
   update_monitors(s, dt, v_ok, r_ok);
   update_confidences();
   if (!act_.learned) return;

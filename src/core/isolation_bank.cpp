@@ -281,14 +281,14 @@ void Isolator::resync_observers(const Sample& s, bool v_ok, bool r_ok) {
   }
 }
 
-bool Isolator::healthy_for_learning(double t, bool v_ok, bool r_ok) const {
-  // Healthy data for learning: both channels usable, and no fault condition raised now or
-  // within resume_after_fault (a fault that hides with the signal clears and re-raises).
+bool Isolator::healthy_for_maxima(double t, bool v_ok, bool r_ok) const {
+  // Both channels usable, and no fault condition raised now or within resume_after_fault (a
+  // fault that hides with the signal clears and re-raises).
   bool faulty = false;
   for (const SensorState& x : sens_) faulty = faulty || x.cond.active;
   // Nor while identification finds the data inconsistent with the vessel's dynamics (a
   // fault no residual sees yet, e.g. one that began while the first design was learning).
-  return v_ok && r_ok && !faulty && !data_inconsistent_ && !st_.model_mismatch &&
+  return v_ok && r_ok && !faulty && !data_inconsistent_ &&
          t - t_last_fault_ >= p_.resume_after_fault;
 }
 
@@ -322,7 +322,7 @@ bool Isolator::evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_
   return true;
 }
 
-void Isolator::record_statistics(double t, const Statistics& x, bool learn_ok) {
+void Isolator::record_statistics(double t, const Statistics& x, bool maxima_ok) {
   for (int c = 0; c < 2; ++c) {
     if (!std::isfinite(x.sw(c))) continue;
     chan_[c].hist_s.emplace_back(t, x.sw(c));
@@ -337,7 +337,7 @@ void Isolator::record_statistics(double t, const Statistics& x, bool learn_ok) {
   if (act_.learned) {
     // Healthy maxima, learned from samples older than a raise could be late.
     pending_stats_.push_back(
-        PendingStat{t, {act_.J(0), act_.J(1), act_.D(0), act_.D(1)}, learn_ok});
+        PendingStat{t, {act_.J(0), act_.J(1), act_.D(0), act_.D(1)}, maxima_ok});
     while (!pending_stats_.empty() && t - pending_stats_.front().t > history_lag()) {
       if (pending_stats_.front().ok)
         healthy_.add(pending_stats_.front().t, pending_stats_.front().x);

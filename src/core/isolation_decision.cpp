@@ -232,7 +232,8 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
           c.repeated >= 0 ? "residual of one channel again" : "residuals of both channels",
           st_.J(0), st_.J(1), lv.thr(0), lv.thr(1), after);
       st_.model_mismatch = true;
-      pending_stats_.clear();
+      // (the statistics before the verdict stay pending for the healthy maxima: the rise
+      // that led to it is the model's too)
       pending_drift_.clear();
       st_.mismatch_reason = buf;
       ++st_.mismatches;

@@ -225,5 +225,38 @@ TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismat
   }
 }
 
+TEST(BenchDrivers, ACourseChangeJudgedTheModelsIsNotRaisedAgainAtTheNextOne) {
+  // GIVEN the healthy first 900 s of a proving-ground run of the 3-DOF Otter (50 Hz, calm
+  // water, +-10 deg course changes every 20 s; its gyro scale error begins at 975 s). Every
+  // course change takes the gyro's J_N to the clip (16) for a moment, above its bar (12): up
+  // to stop 38 that raised the gyro 16 times from 245 to 764 s. Each raise, and each
+  // model-mismatch verdict on such a rise, kept the peak out of the healthy maxima the bar
+  // follows, so the next course change met the same bar.
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick = proving_ground_run("otter3dof @ 50 Hz", "course/calm",
+                                                      13365152606205054189ull, true, &engine_cfg);
+  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
+  ASSERT_GT(pick->fault.t_start, 900.0);
+  const Stream data = pick->make();
+  std::vector<Sample> first;
+  for (const Sample& s : data.samples) {
+    if (s.t <= 900.0) first.push_back(s);
+  }
+  // WHEN the engine with the shipped configuration replays it
+  const MethodResult r = run_engine(engine_cfg, first);
+  // THEN once a rise has been judged the model's, the peaks it brought are part of the
+  // healthy maxima and the course changes after it raise nothing
+  ASSERT_FALSE(r.mismatches.empty());
+  const double judged = r.mismatches.front().t;
+  int raises = 0, after = 0;
+  for (const Alarm& a : r.alarms) {
+    if (!a.raised) continue;
+    ++raises;
+    after += a.t > judged;
+  }
+  EXPECT_EQ(after, 0) << "the first verdict at " << judged << " s";
+  EXPECT_LE(raises, 5);
+}
+
 }  // namespace
 }  // namespace usvfdi::bench

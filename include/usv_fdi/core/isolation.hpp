@@ -362,13 +362,17 @@ class Isolator {
   };
   void propagate_observers(const Sample& s, double dt, bool v_ok, bool r_ok);
   void resync_observers(const Sample& s, bool v_ok, bool r_ok);
-  bool healthy_for_learning(double t, bool v_ok, bool r_ok) const;
+  /// Healthy for the maxima the bars follow: both channels usable, no fault raised now or
+  /// within resume_after_fault, the data consistent with identification. A model-mismatch
+  /// verdict does not stop it (its residual is the model's, and the bar must know it); the
+  /// scales and the other statistics learn only without one.
+  bool healthy_for_maxima(double t, bool v_ok, bool r_ok) const;
   /// Evaluates the redesign (which takes over once it has learned) and the active bank;
   /// false when nothing more is to be done on this sample (settling, no rudder, scales not
   /// learned yet).
   bool evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_ok, bool r_ok,
                       Statistics* x);
-  void record_statistics(double t, const Statistics& x, bool learn_ok);
+  void record_statistics(double t, const Statistics& x, bool maxima_ok);
   void update_monitors(const Sample& s, double dt, bool v_ok, bool r_ok);
   void update_confidences();
   void check_spikes(double t, const Vec2& sw, std::vector<Detection>* out);
