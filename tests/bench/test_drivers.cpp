@@ -178,20 +178,20 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
 }
 
 /// The engine with the shipped configuration (as the proving ground runs it) on the healthy
-/// first 1400 s of a proving-ground run.
-MethodResult replay_slow_passage(std::uint64_t seed) {
+/// first `until` seconds of a proving-ground run (one with a fault, which begins later).
+MethodResult replay_healthy_start(const std::string& table, const std::string& voyage,
+                                  std::uint64_t seed, double until) {
   EngineConfig engine_cfg;
-  const std::optional<Case> pick =
-      proving_ground_run("otter @ 10 Hz", "voyage/sea3/mems", seed, true, &engine_cfg);
+  const std::optional<Case> pick = proving_ground_run(table, voyage, seed, true, &engine_cfg);
   if (!pick) {
     ADD_FAILURE() << "the proving ground no longer has run " << seed;
     return {};
   }
-  EXPECT_GT(pick->fault.t_start, 1400.0);
+  EXPECT_GT(pick->fault.t_start, until);
   const Stream data = pick->make();
   std::vector<Sample> first;
   for (const Sample& s : data.samples) {
-    if (s.t <= 1400.0) first.push_back(s);
+    if (s.t <= until) first.push_back(s);
   }
   return run_engine(engine_cfg, first);
 }
@@ -208,7 +208,7 @@ TEST(BenchDrivers, AGyroResidualThatComesBackAfterARaiseNothingHeldIsModelMismat
   for (const std::uint64_t seed : {8068231856934621647ull, 15453939662217126967ull}) {
     SCOPED_TRACE(seed);
     // WHEN the engine with the shipped configuration replays it up to 1400 s
-    const MethodResult r = replay_slow_passage(seed);
+    const MethodResult r = replay_healthy_start("otter @ 10 Hz", "voyage/sea3/mems", seed, 1400.0);
     // THEN the slow passage raises the gyro at most once; its rises after that are reported
     // as model mismatch, named so
     int gyro_raises = 0, repeats = 0, verdicts = 0;
@@ -232,18 +232,9 @@ TEST(BenchDrivers, ACourseChangeJudgedTheModelsIsNotRaisedAgainAtTheNextOne) {
   // to stop 38 that raised the gyro 16 times from 245 to 764 s. Each raise, and each
   // model-mismatch verdict on such a rise, kept the peak out of the healthy maxima the bar
   // follows, so the next course change met the same bar.
-  EngineConfig engine_cfg;
-  const std::optional<Case> pick = proving_ground_run("otter3dof @ 50 Hz", "course/calm",
-                                                      13365152606205054189ull, true, &engine_cfg);
-  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
-  ASSERT_GT(pick->fault.t_start, 900.0);
-  const Stream data = pick->make();
-  std::vector<Sample> first;
-  for (const Sample& s : data.samples) {
-    if (s.t <= 900.0) first.push_back(s);
-  }
   // WHEN the engine with the shipped configuration replays it
-  const MethodResult r = run_engine(engine_cfg, first);
+  const MethodResult r =
+      replay_healthy_start("otter3dof @ 50 Hz", "course/calm", 13365152606205054189ull, 900.0);
   // THEN once a rise has been judged the model's, the peaks it brought are part of the
   // healthy maxima and the course changes after it raise nothing
   ASSERT_FALSE(r.mismatches.empty());

@@ -65,15 +65,18 @@ TEST(SensorChecks, AFullPrecisionChannelHeldForStuckTimeIsStuckAndMovingAgainIsN
   EXPECT_EQ(f.checks.repeats(kInputV), 0);
 }
 
+// A slow swing printed to 0.01, with noise e added before printing.
+double quantised(double t, double e) {
+  return std::round(100.0 * (0.05 * std::sin(0.05 * t) + e)) / 100.0;
+}
+
 TEST(SensorChecks, AQuantisedChannelThatMovesIsNotStuckButAFrozenOneIs) {
   // A noisy signal printed to 0.01 (its noise about half a quantum): it repeats its value on
   // about half of the samples, sometimes many times in a row.
   Feed f;
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0.0, 0.005);
-  EXPECT_FALSE(f.move_v(600.0, [&](double t) {
-    return std::round(100.0 * (0.05 * std::sin(0.05 * t) + n(rng))) / 100.0;
-  }));
+  EXPECT_FALSE(f.move_v(600.0, [&](double t) { return quantised(t, n(rng)); }));
   // Frozen: caught at the latest after stuck_time_max.
   f.hold_v(0.42, IsolationParams{}.stuck_time_max + 0.5);
   EXPECT_TRUE(f.checks.verdict(kInputV).stuck);
@@ -122,15 +125,13 @@ TEST(SensorChecks, AGapInTheStreamNeitherTeachesTheRateNorHoldsTheValue) {
   Feed f;
   std::mt19937 rng(11);
   std::normal_distribution<double> n(0.0, 0.005);
-  const auto quantised = [&](double t) {
-    return std::round(100.0 * (0.05 * std::sin(0.05 * t) + n(rng))) / 100.0;
-  };
-  ASSERT_FALSE(f.move_v(600.0, quantised));
+  const auto moving = [&](double t) { return quantised(t, n(rng)); };
+  ASSERT_FALSE(f.move_v(600.0, moving));
   const double before_gap = f.checks.verdict(kInputV).value;
   f.t += 120.0;
   // resuming at the value it stopped at, for a few samples, then moving again
   EXPECT_TRUE(std::isnan(f.hold_v(before_gap, 0.45)));
-  EXPECT_FALSE(f.move_v(120.0, quantised));
+  EXPECT_FALSE(f.move_v(120.0, moving));
   // still caught when frozen
   f.hold_v(0.42, IsolationParams{}.stuck_time_max + 0.5);
   EXPECT_TRUE(f.checks.verdict(kInputV).stuck);
