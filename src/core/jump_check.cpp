@@ -296,14 +296,38 @@ bool JumpCheck::persists(int m, double f) const {
   // whose mean happens to be off).
   const double sign = f < 0 ? -1.0 : 1.0;
   int count = 0;
-  double spread = 0.0;
+  double spread = 0.0, sum = 0.0, sum2 = 0.0, sum_j = 0.0, first = 0.0;
   for (int back = 0; back <= m; ++back) {
     const double dev = z_.at(back) - z_.line(m, back);
     if (sign * dev > 0.5 * std::abs(f)) ++count;
     spread += (dev - f) * (dev - f);
+    const int j = m + 1 - back;  // samples after the onset (the first post sample: 1)
+    sum += dev;
+    sum2 += dev * dev;
+    sum_j += dev * j;
+    if (j == 1) first = dev;
   }
   return count >= persist_ && count >= 0.6 * (m + 1) &&
-         std::sqrt(spread / (m + 1)) < 0.5 * std::abs(f);
+         std::sqrt(spread / (m + 1)) < 0.5 * std::abs(f) &&
+         level_not_bend(m + 1, sum, sum2, sum_j, first);
+}
+
+bool JumpCheck::level_not_bend(int n, double sum, double sum2, double sum_j, double first) {
+  // A step, not a bend: a new level fits the post samples better than a new slope does, each
+  // starting at the onset or a sample later (the onset found may be a sample early; one
+  // parameter each). The crest of a wave, the yaw rate of a hull in a seaway turning from
+  // rising to falling, leaves the extrapolated line as a slope; a bias leaves it as a level.
+  // Sums over the n post samples of dev, dev^2 and j dev (j = 1 .. n), and the first dev.
+  if (n < 3) return true;  // too few to tell (persist_samples may be as low as 1)
+  const auto squares = [](double k) { return k * (k + 1) * (2 * k + 1) / 6; };  // 1^2+..+k^2
+  const double level_now = sum2 - sum * sum / n;
+  const double bend_now = sum2 - sum_j * sum_j / squares(n);
+  // Without the first sample, counted from it (j - 1 = 1 .. n - 1).
+  const double rest = sum - first, rest2 = sum2 - first * first;
+  const double rest_j = sum_j - first - rest;
+  const double level_later = first * first + rest2 - rest * rest / (n - 1);
+  const double bend_later = first * first + rest2 - rest_j * rest_j / squares(n - 1);
+  return std::min(level_now, level_later) < std::min(bend_now, bend_later);
 }
 
 void JumpCheck::noise_statistic(double d2sq) {

@@ -137,6 +137,36 @@ TEST(JumpCheck, OutliersAreNeitherJumpsNorNoise) {
   EXPECT_TRUE(s.noises.empty());
 }
 
+TEST(JumpCheck, ABendIsNoJumpButAStepWithASlopeIs) {
+  // GIVEN at 10 Hz, on a channel that moved straight, a crest: its slope turns by 3 sigma a
+  // sample at 100 s and back at 101 s (a wave's top, as the yaw rate of a hull in a seaway
+  // draws it), every 20 s up to 700 s
+  Channel c;
+  const auto bent = channel(c, 700.0, [](double t, long) {
+    if (t < 100.0) return 0.0;
+    const double x = std::fmod(t - 100.0, 20.0);
+    return 30.0 * kSigma * std::max(0.0, std::min(x, 2.0 - x));
+  });
+  // THEN none is a jump: after the turn the samples follow a new slope, not a new level
+  // (before: each of the 31 crests was raised)
+  const Seen s = run_check(bent);
+  const auto raises = std::count_if(s.steps.begin(), s.steps.end(), [](const JumpVerdict& v) {
+    return v.step == JumpVerdict::Change::kRaise;
+  });
+  EXPECT_EQ(raises, 0) << "the first at " << s.step_t.front() << " s";
+  EXPECT_TRUE(s.steps.empty());
+  // AND a 10 sigma step that comes with a new slope of 2 sigma a sample (a scale error on a
+  // moving signal) is one: raised within half a second
+  const auto scaled = channel(c, 200.0, [](double t, long) {
+    return t >= 100.0 ? 10.0 * kSigma + 20.0 * kSigma * (t - 100.0) : 0.0;
+  });
+  const Seen k = run_check(scaled);
+  ASSERT_FALSE(k.steps.empty());
+  EXPECT_EQ(k.steps[0].step, JumpVerdict::Change::kRaise);
+  EXPECT_GE(k.step_t[0], 100.0);
+  EXPECT_LE(k.step_t[0], 100.5);
+}
+
 TEST(JumpCheck, AnHourOfHealthyDataWithAWrongBAndALaggingRudderRaisesNothing) {
   for (double rate : {10.0, 50.0}) {
     SCOPED_TRACE(rate);
