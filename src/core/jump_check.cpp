@@ -309,18 +309,20 @@ bool JumpCheck::persists(int m, double f) const {
   }
   return count >= persist_ && count >= 0.6 * (m + 1) &&
          std::sqrt(spread / (m + 1)) < 0.5 * std::abs(f) &&
-         level_not_bend(m + 1, sum, sum2, sum_j, first);
+         level_not_bend(m + 1, spread, sum, sum2, sum_j, first);
 }
 
-bool JumpCheck::level_not_bend(int n, double sum, double sum2, double sum_j, double first) {
+bool JumpCheck::level_not_bend(int n, double spread, double sum, double sum2, double sum_j,
+                               double first) {
   // A step, not a bend: a new level fits the post samples better than a new slope does, each
   // starting at the onset or a sample later (the onset found may be a sample early; one
   // parameter each). The crest of a wave, the yaw rate of a hull in a seaway turning from
   // rising to falling, leaves the extrapolated line as a slope; a bias leaves it as a level.
-  // Sums over the n post samples of dev, dev^2 and j dev (j = 1 .. n), and the first dev.
+  // Sums over the n post samples of dev, dev^2 and j dev (j = 1 .. n), and the first dev;
+  // spread, the squares about the new level from the onset, is the level's fit from it.
   if (n < 3) return true;  // too few to tell (persist_samples may be as low as 1)
   const auto squares = [](double k) { return k * (k + 1) * (2 * k + 1) / 6; };  // 1^2+..+k^2
-  const double level_now = sum2 - sum * sum / n;
+  const double level_now = spread;
   const double bend_now = sum2 - sum_j * sum_j / squares(n);
   // Without the first sample, counted from it (j - 1 = 1 .. n - 1).
   const double rest = sum - first, rest2 = sum2 - first * first;

@@ -212,9 +212,11 @@ class JumpCheck {
   /// The step statistics of the samples held: T_ and the best onset (*m_best, *f_best).
   void step_statistics(int* m_best, double* f_best);
   bool persists(int m, double f) const;
-  /// A new level, not a new slope, explains the n post samples (their sum, sum of squares,
-  /// sum of j x each for j = 1 .. n, and the first); true below 3 samples.
-  static bool level_not_bend(int n, double sum, double sum2, double sum_j, double first);
+  /// A new level, not a new slope, explains the n post samples (their squares about the
+  /// level, sum, sum of squares, sum of j x each for j = 1 .. n, and the first); true below
+  /// 3 samples.
+  static bool level_not_bend(int n, double spread, double sum, double sum2, double sum_j,
+                             double first);
   void noise_statistic(double d2sq);
   /// Learns from a sample once it is M samples old and no jump or noise rise was found
   /// since (the first samples of a fault come before its detection).
