@@ -57,6 +57,7 @@ void IsolationParams::validate() const {
   require(exit_ratio * threshold > 1, "exit_ratio", exit_ratio,
           "exit_ratio * threshold must exceed 1 (healthy J_N is about 1)");
   require(enter_time >= 0, "enter_time", enter_time, "must be >= 0");
+  require(young_enter_ratio >= 1, "young_enter_ratio", young_enter_ratio, "must be >= 1");
   require(leave_time >= 0, "leave_time", leave_time, "must be >= 0");
   require(second_fault_time >= 0, "second_fault_time", second_fault_time, "must be >= 0");
   require(mismatch_window >= 0, "mismatch_window", mismatch_window, "must be >= 0");

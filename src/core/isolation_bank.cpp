@@ -70,8 +70,12 @@ bool Isolator::design(const Mat2& A, Bank* b) {
   return true;
 }
 
+double Isolator::sensor_enter_time() const {
+  return healthy_.covered() < p_.history ? p_.young_enter_ratio * p_.enter_time : p_.enter_time;
+}
+
 double Isolator::history_lag() const {
-  return p_.window + std::max(p_.enter_time, p_.second_fault_time) + 1.0;
+  return p_.window + std::max(sensor_enter_time(), p_.second_fault_time) + 1.0;
 }
 
 void Isolator::publish_bank() {

@@ -207,8 +207,11 @@ Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {
 void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
                                  std::vector<Detection>* out) {
   const bool a_res = sens_[0].cond.sources & kResidual, g_res = sens_[1].cond.sources & kResidual;
-  const double enter =
-      (a_res || g_res) && c.k != 2 ? std::max(p_.enter_time, p_.second_fault_time) : p_.enter_time;
+  // (a sensor another check already raised, a jump for one, needs no longer confirmation)
+  const double own = c.k < 2 && sens_[c.k].cond.sources != 0 ? p_.enter_time : sensor_enter_time();
+  const double enter = c.k == 2           ? p_.enter_time
+                       : (a_res || g_res) ? std::max(own, p_.second_fault_time)
+                                          : own;
   for (int k = 0; k < 3; ++k) {
     if (k != c.k) {
       sens_[k].above_since = kNaN;

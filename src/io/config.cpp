@@ -317,6 +317,7 @@ class Loader {
         {"history", number_into(&is->history, {10, 100 * kHour, "s"})},
         {"exit_ratio", number_into(&is->exit_ratio, {0, 1, ""})},
         {"enter_time", number_into(&is->enter_time, {0, 60, "s"})},
+        {"young_enter_ratio", number_into(&is->young_enter_ratio, {1, 100, ""})},
         {"leave_time", number_into(&is->leave_time, {0, kHour, "s"})},
         {"second_fault_time", number_into(&is->second_fault_time, {0, kHour, "s"})},
         {"mismatch_window", number_into(&is->mismatch_window, {0, kHour, "s"})},

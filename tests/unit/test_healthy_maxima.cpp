@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "usv_fdi/core/engine.hpp"
@@ -87,6 +88,63 @@ TEST(IsolatorThresholds, AModelMismatchMetInHealthyManoeuvresRaisesTheBar) {
   // the mismatch of each course change is taken for a fault
   p.history = 10.0;
   EXPECT_GT(raises_after(p, 600.0), 0);
+}
+
+/// Times of the gyro's raises on the Otter's course changes, the isolation stage given the
+/// true A (an oracle), with a gyro drift injected on each of the given intervals.
+std::vector<double> gyro_raises(const IsolationParams& p,
+                                const std::vector<std::pair<double, double>>& drifts) {
+  VesselModel v;
+  EXPECT_TRUE(find_vessel("otter", &v));
+  SimConfig sim;
+  sim.vessel = v;
+  sim.rate_hz = 10.0;
+  sim.duration = 1000.0;
+  sim.seed = 5;
+  for (const auto& [from, to] : drifts) {
+    sim.faults.push_back({Sensor::kGyro, FaultKind::kDrift, from, to, 0.002});
+  }
+  Isolator iso(p, v.B);
+  Estimate est;
+  est.A = v.A;
+  est.converged = true;
+  est.warming_up = false;
+  est.status = IdentStatus::kConverged;
+  std::vector<double> raises;
+  bool given = false;
+  std::vector<Detection> dets;
+  for (const SimRow& r : simulate(sim)) {
+    dets.clear();
+    iso.update({r.t, r.v, r.r, r.delta}, &dets);
+    if (!given) {
+      est.t = r.t;
+      iso.set_estimate(est);
+      given = true;
+    }
+    for (const Detection& d : dets) {
+      if (d.sensor == Sensor::kGyro && d.active && !d.update) raises.push_back(r.t);
+    }
+  }
+  return raises;
+}
+
+TEST(IsolatorThresholds, WhileTheBarsAreYoungAResidualRaiseIsConfirmedLonger) {
+  // GIVEN a gyro drift while the healthy maxima cover less than `history` (at 200 s) and
+  // one after (at 900 s, `history` being 600 s), seen by the observers alone
+  IsolationParams p;
+  p.jump.enabled = false;
+  const std::vector<std::pair<double, double>> drifts = {{200.0, 230.0}, {900.0, 930.0}};
+  // WHEN the young bars' confirmation is that of the older ones, and when it is twice as long
+  p.young_enter_ratio = 1.0;
+  const std::vector<double> same = gyro_raises(p, drifts);
+  p.young_enter_ratio = 2.0;
+  const std::vector<double> longer = gyro_raises(p, drifts);
+  // THEN each drift is raised once either way; the young one enter_time later with the
+  // longer confirmation, the later one at the same sample
+  ASSERT_EQ(same.size(), 2u);
+  ASSERT_EQ(longer.size(), 2u);
+  EXPECT_NEAR(longer[0] - same[0], p.enter_time, 0.15);
+  EXPECT_NEAR(longer[1], same[1], 1e-9);
 }
 
 TEST(IsolatorKinds, AFrozenOutputIsNamedStuckWhateverRaisedItFirst) {

@@ -63,6 +63,12 @@ struct IsolationParams {
   /// quiet: model mismatch lights the other channel within seconds, a single sensor's fault
   /// never (and the jump check raises a sudden offset at once) [s]
   double enter_time = 2.5;
+  /// ... times this while the healthy maxima cover less than `history` (after learning, and
+  /// after a restart of the maxima): their bars then follow the largest of a few minutes
+  /// only, extrapolated, and a manoeuvre the hull has not yet made lifts J_N over them for
+  /// a few seconds. A sensor another check has raised (a jump) is confirmed in enter_time.
+  /// Off (1) by default: docs/benchmark.md, "Young bars" [-]
+  double young_enter_ratio = 1.0;
   double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
@@ -440,6 +446,9 @@ class Isolator {
   };
   std::deque<PendingDrift> pending_drift_;
   double history_lag() const;
+  /// How long J_N must stay above its bar to raise a sensor (enter_time, times young_enter_ratio
+  /// while the bars are young).
+  double sensor_enter_time() const;
   double last_delta_ = kNaN;
   std::array<ChannelState, 2> chan_;  ///< v, r
   std::array<SensorState, 3> sens_;   ///< accelerometer, gyro, unknown
