@@ -208,7 +208,9 @@ void Isolator::confirm_candidate(double t, const Levels& lv, const Candidate& c,
                                  std::vector<Detection>* out) {
   const bool a_res = sens_[0].cond.sources & kResidual, g_res = sens_[1].cond.sources & kResidual;
   // (a sensor another check already raised, a jump for one, needs no longer confirmation)
-  const double own = c.k < 2 && sens_[c.k].cond.sources != 0 ? p_.enter_time : sensor_enter_time();
+  // (c.k is -1 when nothing is a candidate: no sensor to look at)
+  const bool raised = c.k >= 0 && c.k < 2 && sens_[c.k].cond.sources != 0;
+  const double own = raised ? p_.enter_time : sensor_enter_time();
   const double enter = c.k == 2           ? p_.enter_time
                        : (a_res || g_res) ? std::max(own, p_.second_fault_time)
                                           : own;
