@@ -3,7 +3,8 @@
 # then builds the DDS service's tests under ThreadSanitizer (./build-tsan) and
 # AddressSanitizer + UBSan (./build-asan) and runs them: the pipeline's threading tests, the
 # sidecar in-process behind real Fast DDS, and the end-to-end tests of the instrumented
-# usv-fdi executable in separate processes.
+# usv-fdi executable in separate processes; under ASan + UBSan also the golden replays (the
+# engine itself).
 #
 #   USV_FDI_SANITIZERS="thread address"  (default) which sanitizer builds to run; "" for none
 #   BUILD_DIR=build                      the main build directory
@@ -31,6 +32,12 @@ for san in ${USV_FDI_SANITIZERS-thread address}; do
   cmake --build "$dir" -j "$(nproc)" --target "${san_targets[@]}"
   ctest --test-dir "$dir" -L 'service|dds_e2e' --output-on-failure -j 2 --timeout 600 ||
     failed+=("$dir")
+  if [[ "$san" == address ]]; then
+    # The engine itself, single-threaded, under ASan + UBSan: the golden replays (usv-fdi
+    # replay of every committed case, its output diffed exactly).
+    ctest --test-dir "$dir" -R '^golden_output_' --output-on-failure -j 2 --timeout 600 ||
+      failed+=("$dir (golden)")
+  fi
 done
 if ((${#failed[@]} > 0)); then
   echo "test.sh: tests failed in: ${failed[*]}" >&2
