@@ -114,16 +114,25 @@ double Isolator::learned_threshold(std::vector<double>* healthy) const {
                   reachable_threshold());
 }
 
-double Isolator::history_threshold(double healthy_max) const {
-  // history_margin x the healthy maximum; but a windowed mean of clipped squares saturates
-  // at clip^2, and a bar at or above it made the channel blind without a word (a gyro drift
-  // of 10 sigma in 10 s on the Otter was never raised, J at 16 against 16.1). Such a bar
-  // becomes the highest threshold the statistic reaches with margin, or kMinHistoryMargin x
-  // the healthy maximum when that is higher: a fault that pegs the statistic is seen.
+double history_bar(double healthy_max, double margin, double clip) {
+  // A windowed mean of clipped squares saturates at clip^2; a bar at or above it made the
+  // channel blind without a word (a gyro drift of 10 sigma in 10 s on the Otter was never
+  // raised, J at 16 against 16.1). So the bar is margin x the maximum only up to a knee that
+  // leaves the statistic a quarter of the bar above it (0.8 clip^2), and there it stays until
+  // kMinHistoryMargin x the maximum passes it: a fault that pegs the statistic is seen.
+  // (Before, margin x the maximum ran on to 0.98 clip^2 and then fell to 0.75 clip^2: with
+  // clip 4 and a margin of 1.5 the bar dropped from 15.7 to 12 as the maximum rose past
+  // 10.45, and the drop restarted the confirmation of a rising gyro drift. Knees of 0.75,
+  // 0.85 and 0.9 clip^2 each fail a guard test: docs/benchmark.md, "The history bar".)
   constexpr double kMinHistoryMargin = 1.05;
-  const double bar = p_.history_margin * healthy_max;
-  if (bar < 0.98 * p_.clip * p_.clip) return bar;
-  return std::max(reachable_threshold(), kMinHistoryMargin * healthy_max);
+  const double knee = 0.8 * clip * clip;
+  const double bar = margin * healthy_max;
+  if (bar <= knee) return bar;
+  return std::max(knee, kMinHistoryMargin * healthy_max);
+}
+
+double Isolator::history_threshold(double healthy_max) const {
+  return history_bar(healthy_max, p_.history_margin, p_.clip);
 }
 
 std::size_t Isolator::window_samples(double dt) const {

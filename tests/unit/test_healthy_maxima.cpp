@@ -147,6 +147,29 @@ TEST(IsolatorThresholds, WhileTheBarsAreYoungAResidualRaiseIsConfirmedLonger) {
   EXPECT_NEAR(longer[1], same[1], 1e-9);
 }
 
+TEST(IsolatorThresholds, TheHistoryBarNeverFallsAsTheHealthyMaximumRisesAndStaysReachable) {
+  const double clip = 4.0, knee = 0.8 * clip * clip;
+  for (const double margin : {1.2, 4.0 / 3.0, 1.5, 2.0}) {
+    // GIVEN healthy maxima from 0 to past the clip, in small steps
+    double last = 0.0;
+    for (double h = 0.0; h <= 1.2 * clip * clip; h += 0.001) {
+      const double bar = history_bar(h, margin, clip);
+      // THEN the bar never falls as the maximum rises (a falling bar restarts the
+      // confirmation of a rise that the rising maximum follows)
+      ASSERT_GE(bar, last) << "margin " << margin << ", healthy maximum " << h;
+      last = bar;
+      // AND it is margin x the maximum wherever that leaves the statistic room above it
+      if (margin * h <= knee) {
+        ASSERT_DOUBLE_EQ(bar, margin * h) << "margin " << margin;
+      }
+      // AND a statistic pegged at the clip (clip^2) passes it while the maximum leaves room
+      if (1.05 * h < clip * clip) {
+        ASSERT_LT(bar, clip * clip) << "margin " << margin << ", healthy maximum " << h;
+      }
+    }
+  }
+}
+
 TEST(IsolatorKinds, AFrozenOutputIsNamedStuckWhateverRaisedItFirst) {
   // GIVEN a gyro that moves (a slow swing and white noise), then jumps by 20 sigma and
   // freezes at 100 s: the jump check raises it before the stuck check has seen enough

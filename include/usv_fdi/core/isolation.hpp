@@ -67,8 +67,9 @@ struct IsolationParams {
   /// after a restart of the maxima): their bars then follow the largest of a few minutes
   /// only, extrapolated, and a manoeuvre the hull has not yet made lifts J_N over them for
   /// a few seconds. A sensor another check has raised (a jump) is confirmed in enter_time.
-  /// Off (1) by default: docs/benchmark.md, "Young bars" [-]
-  double young_enter_ratio = 1.0;
+  /// 1.5 with the history bar that never falls (history_bar): docs/benchmark.md, "The
+  /// history bar" [-]
+  double young_enter_ratio = 1.5;
   double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
@@ -193,6 +194,12 @@ struct IsolatorStatus {
   /// cannot raise).
   Vec2 drift_S = Vec2::Zero(), drift_threshold = Vec2::Zero();
 };
+
+/// The bar the healthy past sets on a windowed mean of squares clipped at +-clip whose
+/// healthy maximum is healthy_max: margin x healthy_max up to a knee at 0.8 clip^2, then the
+/// larger of the knee and 1.05 x healthy_max. Non-decreasing in healthy_max, and below
+/// clip^2 (a fault that pegs the statistic is still raised) while 1.05 x healthy_max < clip^2.
+double history_bar(double healthy_max, double margin, double clip);
 
 class Isolator {
  public:
