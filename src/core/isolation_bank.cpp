@@ -118,8 +118,9 @@ double history_bar(double healthy_max, double margin, double clip) {
   // A windowed mean of clipped squares saturates at clip^2; a bar at or above it made the
   // channel blind without a word (a gyro drift of 10 sigma in 10 s on the Otter was never
   // raised, J at 16 against 16.1). So the bar is margin x the maximum only up to a knee that
-  // leaves the statistic a quarter of the bar above it (0.8 clip^2), and there it stays until
-  // kMinHistoryMargin x the maximum passes it: a fault that pegs the statistic is seen.
+  // leaves the statistic a quarter of the bar above it (0.8 clip^2); above it the bar is the
+  // larger of the knee and kMinHistoryMargin x the maximum: a fault that pegs the statistic
+  // is seen.
   // (Before, margin x the maximum ran on to 0.98 clip^2 and then fell to 0.75 clip^2: with
   // clip 4 and a margin of 1.5 the bar dropped from 15.7 to 12 as the maximum rose past
   // 10.45, and the drop restarted the confirmation of a rising gyro drift. Knees of 0.75,

@@ -53,7 +53,8 @@ struct IsolationParams {
   double threshold_margin = 1.5;  ///< learned threshold: at least margin * 99.9 % quantile
   double threshold_k = 8.0;       ///< learned threshold: median + k robust std of healthy J_N
   /// After learning, the thresholds on J_N and D_N are at least history_margin x the largest
-  /// value each took on healthy data over the last `history` seconds: they follow the hull,
+  /// value each took on healthy data over the last `history` seconds (near the clip, at least
+  /// the knee and 1.05 x it: history_bar): they follow the hull,
   /// the sea and the manoeuvres met since (a J_N the model's mismatch reaches in a zigzag is
   /// no evidence of a sensor fault) [-]
   double history_margin = 1.5;
