@@ -80,11 +80,12 @@ struct DashboardArgs {
 /// when a page or GET /api/board asks for it) and the acks asked for.
 class Hub {
  public:
-  /// A new board, as the change from the one before (every live page's next message).
-  void publish_delta(std::string delta) {
+  /// A new board, as the change from the one before (every live page's next message), and
+  /// its revision (BoardFramer::revision(): one more than the last).
+  void publish_delta(std::uint64_t revision, std::string delta) {
     {
       std::lock_guard<std::mutex> l(m_);
-      ++version_;
+      version_ = revision;
       deltas_.emplace_back(version_, std::move(delta));
       while (deltas_.size() > kDeltas) deltas_.pop_front();
     }
@@ -741,8 +742,9 @@ int serve(const DashboardArgs& a, FleetView& view, const db::EventHistory& event
     if (board || metrics) {
       refresh_board_input(view, &in, &touched);
       if (board) {
-        hub.publish_delta(
-            framer.delta(in, &touched, events, acks.outcomes(), wall_now(), !a.read_only));
+        std::string delta =
+            framer.delta(in, &touched, events, acks.outcomes(), wall_now(), !a.read_only);
+        hub.publish_delta(framer.revision(), std::move(delta));
         touched.clear();
         last_board = now;
       }
@@ -830,7 +832,9 @@ int run_dashboard(DashboardArgs& a) {
   {
     std::set<std::uint32_t> touched;
     refresh_board_input(*view, &in, &touched);
-    hub.publish_delta(framer.delta(in, nullptr, events, acks.outcomes(), wall_now(), !a.read_only));
+    std::string delta =
+        framer.delta(in, nullptr, events, acks.outcomes(), wall_now(), !a.read_only);
+    hub.publish_delta(framer.revision(), std::move(delta));
     hub.publish_full(framer.full(in, events, acks.outcomes(), wall_now(), !a.read_only));
     hub.set_metrics(db::fleet_metrics(in, events, acks.outcomes()));
   }

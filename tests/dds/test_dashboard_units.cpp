@@ -90,8 +90,10 @@ TEST(DashboardBoard, TheBoardHasEveryVesselHeardLatchedOrOnTheRoster) {
   EXPECT_NO_THROW(nlohmann::json::parse(j.dump()));
 }
 
-/// What the page does with a delta (applyDelta in web/app.js), in C++.
+/// What the page does with a delta (applyDelta in web/app.js), in C++: only the next revision.
 nlohmann::json apply_delta(nlohmann::json board, const nlohmann::json& d) {
+  EXPECT_EQ(d["revision"].get<std::uint64_t>(), board["revision"].get<std::uint64_t>() + 1)
+      << "a page takes only the delta after its board";
   std::map<std::uint32_t, nlohmann::json> vessels;
   for (const auto& v : board["vessels"]) vessels[v["mmsi"].get<std::uint32_t>()] = v;
   for (const auto& m : d["removed"]) vessels.erase(m.get<std::uint32_t>());
@@ -114,7 +116,9 @@ nlohmann::json apply_delta(nlohmann::json board, const nlohmann::json& d) {
   for (const auto& e : board["events"]) events.push_back(e);
   while (events.size() > d["event_capacity"].get<std::size_t>()) events.erase(events.size() - 1);
   board["events"] = events;
-  for (const char* k : {"now", "silent_after", "conflicts", "acks", "can_ack"}) board[k] = d[k];
+  for (const char* k : {"now", "silent_after", "conflicts", "acks", "can_ack", "revision"}) {
+    board[k] = d[k];
+  }
   return board;
 }
 
@@ -125,11 +129,13 @@ nlohmann::json without_event_ages(nlohmann::json j) {
   return j;
 }
 
-/// board_json and the can_ack the framer's boards carry.
+/// board_json and the can_ack and revision the framer's boards carry.
 nlohmann::json board_json_with_can_ack(const BoardInput& in, const EventHistory& h,
-                                       const std::deque<AckOutcome>& acks, double now) {
+                                       const std::deque<AckOutcome>& acks, double now,
+                                       std::uint64_t revision) {
   nlohmann::json j = board_json(in, h, acks, now);
   j["can_ack"] = true;
+  j["revision"] = revision;
   return j;
 }
 
@@ -153,11 +159,15 @@ TEST(DashboardBoard, DeltasCarryOnlyWhatChangedAndApplyToTheNextBoard) {
   EXPECT_TRUE(board["can_ack"].get<bool>());
   EXPECT_EQ(d["vessels"].size(), 4u);
   EXPECT_EQ(d["events"].size(), 1u);
+  // AND both are revision 1 (the whole board is as of the last delta)
+  EXPECT_EQ(d["revision"], 1);
+  EXPECT_EQ(board["revision"], 1);
   // WHEN only time passes (every vessel heard again, nothing latched changes)
   for (std::uint32_t m = 1; m <= 4; ++m) in.heard_age[m] = 0.2 * m;
   f = framer.frame(in, h, acks, 101.0, true);
   d = nlohmann::json::parse(f.delta);
-  // THEN the delta carries no vessel and no event, only the ages
+  // THEN the delta carries no vessel and no event, only the ages, as revision 2
+  EXPECT_EQ(d["revision"], 2);
   EXPECT_EQ(d["vessels"].size(), 0u) << d.dump();
   EXPECT_EQ(d["events"].size(), 0u);
   EXPECT_DOUBLE_EQ(d["heard_age"]["3"].get<double>(), 0.6);
@@ -242,7 +252,7 @@ TEST(DashboardBoard, ADeltaRebuildsOnlyTheVesselsThatChanged) {
   // AND the whole board built on demand is the one the deltas put together
   const nlohmann::json full = nlohmann::json::parse(framer.full(in, h, acks, 101.0, true));
   EXPECT_EQ(without_event_ages(apply_delta(board, d)), without_event_ages(full));
-  EXPECT_EQ(full, board_json_with_can_ack(in, h, acks, 101.0));
+  EXPECT_EQ(full, board_json_with_can_ack(in, h, acks, 101.0, 2));
   // WHEN nothing is touched, THEN nothing is built again
   framer.delta(in, &touched, h, acks, 102.0, true);
   EXPECT_EQ(framer.rebuilt(), 3u) << "the touched ones, found unchanged";

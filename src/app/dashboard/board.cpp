@@ -313,6 +313,7 @@ std::string BoardFramer::delta(const BoardInput& in, const std::set<std::uint32_
   json delta = board_fields(in, now, acks);
   delta["can_ack"] = can_ack;
   delta["delta"] = true;
+  delta["revision"] = ++revision_;
   delta["vessels"] = std::move(changed);
   delta["removed"] = std::move(removed);
   delta["events"] = events.newest_json(fresh, now);
@@ -328,6 +329,7 @@ std::string BoardFramer::full(const BoardInput& in, const EventHistory& events,
   for (const auto& [m, e] : entries_) vessels.push_back(with_ages(e.bare, in, now));
   json board = board_fields(in, now, acks);
   board["can_ack"] = can_ack;
+  board["revision"] = revision_;
   board["vessels"] = std::move(vessels);
   board["events"] = events.to_json(now);
   return dump(board);

@@ -111,6 +111,10 @@ struct BoardFrame {
   /// else of their vessel's entry (stamp, a, excitation, sigma_v, sigma_r, samples, dropped,
   /// surge_speed, speed_ratio, written), to be set into that entry's status. A sensor's age_s
   /// is now - written.
+  ///
+  /// Both carry "revision": the number of the delta (1, 2, ...; the whole board: that of the
+  /// last delta), so that a page knows when a delta is missing, and a board can be compared
+  /// with a page's at the same revision.
   std::string delta;
 };
 
@@ -134,6 +138,8 @@ class BoardFramer {
                    const std::deque<AckOutcome>& acks, double now, bool can_ack);
   /// Entries rebuilt by the last delta (a measure of its work).
   std::size_t rebuilt() const { return rebuilt_; }
+  /// The last delta's revision (0 before the first).
+  std::uint64_t revision() const { return revision_; }
 
  private:
   struct Entry {
@@ -144,6 +150,7 @@ class BoardFramer {
   std::map<std::uint32_t, Entry> entries_;
   std::uint64_t events_framed_ = 0;  ///< EventHistory::added() at the last delta
   std::size_t rebuilt_ = 0;
+  std::uint64_t revision_ = 0;
 };
 
 }  // namespace usvfdi::app::dashboard

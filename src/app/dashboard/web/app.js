@@ -315,7 +315,7 @@ function applyDelta(d) {
   }
   board.vessels = [...vessels.values()].sort((a, b) => a.mmsi - b.mmsi);
   board.events = d.events.concat(board.events).slice(0, d.event_capacity);
-  for (const k of ['now', 'silent_after', 'conflicts', 'acks', 'can_ack']) board[k] = d[k];
+  for (const k of ['now', 'silent_after', 'conflicts', 'acks', 'can_ack', 'revision']) board[k] = d[k];
 }
 
 function connect() {
@@ -324,6 +324,14 @@ function connect() {
   es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
   es.onmessage = (m) => {
     const msg = JSON.parse(m.data);
+    if (msg.delta && board && msg.revision !== board.revision + 1) {
+      // A delta missed (or one from before the board we have): the board would drift from the
+      // dashboard's. A new stream starts with the whole board.
+      es.close();
+      link.textContent = 'reconnecting'; link.className = 'link down';
+      connect();
+      return;
+    }
     if (msg.delta && board) {
       applyDelta(msg);
     } else {

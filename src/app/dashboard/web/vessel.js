@@ -121,8 +121,17 @@ function connect() {
   const es = new EventSource('/api/stream');
   es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
   let v = null;  // this vessel's entry on the board
+  let revision = null;  // the board's (BoardFrame in src/app/dashboard/board.hpp)
   es.onmessage = (m) => {
     const board = JSON.parse(m.data);
+    if (board.delta && revision !== null && board.revision !== revision + 1) {
+      // a delta missed: a new stream starts with the whole board
+      es.close();
+      link.textContent = 'reconnecting'; link.className = 'link down';
+      connect();
+      return;
+    }
+    revision = board.revision;
     const mine = board.vessels.find((x) => x.mmsi === mmsi);
     if (!board.delta || mine) {
       v = mine || null;  // the whole board, or this vessel's entry changed
