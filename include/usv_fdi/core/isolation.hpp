@@ -265,8 +265,10 @@ class Isolator {
   /// What the residual evaluation keeps of one INS channel (0: v, the accelerometer's; 1: r,
   /// the gyro's) beside the banks.
   struct ChannelState {
-    bool resync = false;                           ///< restart the channel's own observer (cleared)
-    double resettle_until = kNaN;                  ///< the restarted observer settles
+    bool resync = false;           ///< restart the channel's own observer (cleared)
+    double resettle_until = kNaN;  ///< the restarted observer settles
+    /// Its J_N seen at or below its enter threshold since arming: a sensor fault has an onset.
+    bool onset_seen = false;
     std::deque<std::pair<double, double>> hist_s;  ///< (t, whitened structured residual)
     std::deque<std::pair<double, double>> hist_d;  ///< (t, raw cross residual)
     std::deque<std::pair<double, double>> hist_x;  ///< (t, other-observer state)
@@ -365,6 +367,7 @@ class Isolator {
   struct Levels {
     Vec2 thr = Vec2::Zero();         ///< enter thresholds on J_N
     Vec2 ratio = Vec2::Zero();       ///< J_N / thr (0 while a window refills or resettles)
+    bool live[2] = {true, true};     ///< ratio(c) is from a full window, settled
     Vec2 thr_exit_d = Vec2::Zero();  ///< leave thresholds on D_N
     std::size_t n_full = 0;          ///< samples in a full window
   };
@@ -391,6 +394,8 @@ class Isolator {
   void update_confidences();
   void check_spikes(double t, const Vec2& sw, std::vector<Detection>* out);
   Levels levels(double t, double dt) const;
+  /// Keeps a channel that has not been at or below its bar since arming out of the levels.
+  void await_onsets(Levels* lv);
   Candidate choose_candidate(double t, const Levels& lv);
   void confirm_candidate(double t, const Levels& lv, const Candidate& c,
                          std::vector<Detection>* out);
