@@ -157,6 +157,7 @@ void Isolator::await_onsets(Levels* lv) {
   // at or below its bar once, as while it settles.
   for (int c = 0; c < 2; ++c) {
     if (lv->live[c] && lv->ratio(c) <= 1.0) chan_[c].onset_seen = true;
+    st_.awaiting_onset[c] = lv->live[c] && !chan_[c].onset_seen;
     if (!chan_[c].onset_seen) {
       lv->ratio(c) = 0.0;
       lv->live[c] = false;

@@ -136,6 +136,13 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
     msg += "armed, learning healthy statistics; ";
   } else {
     msg += "armed; ";
+    // (said, because the channel's residual path is closed until then)
+    for (int c = 0; c < 2; ++c) {
+      if (s.isolation.awaiting_onset[c]) {
+        msg += std::string(c == 0 ? "accelerometer" : "gyro") +
+               " residual above its bar since going live: raises nothing until it falls; ";
+      }
+    }
   }
   if (s.identification_paused & pipeline::kPauseFault) msg += "identification frozen (fault); ";
   if (s.rejected > 0) msg += std::to_string(s.rejected) + " samples rejected; ";

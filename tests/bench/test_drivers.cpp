@@ -126,6 +126,28 @@ TEST(BenchDrivers, AResidualAboveItsBarWhenDetectionGoesLiveIsNotRaised) {
       ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
     }
   }
+  // AND the status says so while it lasts: the gyro awaits its onset from the first live
+  // sample until its J_N falls (907.9 s); the accelerometer, below its bar, does not
+  FdiEngine engine(engine_cfg);
+  std::vector<FaultEvent> events;
+  double first = kNaN, last = kNaN;
+  bool accelerometer = false;
+  for (const Sample& s : data.samples) {
+    if (s.t > 960.0) break;
+    events.clear();
+    engine.process(s, &events);
+    const IsolatorStatus& st = engine.isolation_status();
+    if (st.awaiting_onset[1]) {
+      if (std::isnan(first)) first = s.t;
+      last = s.t;
+    }
+    accelerometer = accelerometer || st.awaiting_onset[0];
+  }
+  ASSERT_TRUE(std::isfinite(first));
+  EXPECT_NEAR(first, r.t_armed, 0.5);
+  EXPECT_GT(last, 905.0);
+  EXPECT_LT(last, 909.0);
+  EXPECT_FALSE(accelerometer);
 }
 
 TEST(BenchDrivers, ABiasTheJumpCheckRaisedIsNotShownRectifiedBeforeHoldMax) {

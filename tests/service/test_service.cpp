@@ -420,6 +420,23 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
               static_cast<unsigned long long>(st.dropped_inputs));
 }
 
+TEST(StatusMessage, SaysWhichChannelAwaitsItsOnset) {
+  // GIVEN a live detector whose gyro residual has been above its bar since it went live
+  pipeline::PipelineStatus st;
+  st.isolation.armed = true;
+  st.isolation.awaiting_onset = {false, true};
+  // THEN the status says so, within the message's 127 characters
+  const std::string msg = to_dds(st, 257000001, IsolationParams{}).message().to_string();
+  EXPECT_NE(msg.find("gyro residual above its bar since going live: raises nothing until it "
+                     "falls"),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(msg.find("accelerometer residual"), std::string::npos) << msg;
+  // AND once it has fallen, nothing is said
+  st.isolation.awaiting_onset = {false, false};
+  EXPECT_EQ(to_dds(st, 257000001, IsolationParams{}).message().to_string(), "armed; ");
+}
+
 TEST(ServiceInProcess, RefusesAMissingMmsiAndAnUnknownProfileByName) {
   ServiceConfig cfg = paper_service(0, partition());
   EXPECT_THROW(FdiService(cfg, nullptr), std::invalid_argument);

@@ -184,6 +184,9 @@ struct IsolatorStatus {
   bool model_mismatch = false;
   std::string mismatch_reason;   ///< why (empty when there is none)
   std::uint64_t mismatches = 0;  ///< verdicts of model mismatch so far
+  /// Per channel [accelerometer, gyro]: detection is live but the channel's J_N has been above
+  /// its bar ever since, so its residual raises nothing until it falls once (no onset yet).
+  std::array<bool, 2> awaiting_onset{};
   InputHealth input;
   std::uint64_t samples = 0;
   /// The jump check per channel [accelerometer, gyro] (core/jump_check.hpp).
