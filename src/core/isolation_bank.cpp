@@ -94,6 +94,9 @@ void Isolator::publish_bank() {
           std::max(st_.thresholds_d(c), history_threshold(healthy_.extrapolated_max(2 + c)));
     }
   }
+  for (int c = 0; c < 2; ++c) {
+    st_.bar_unreachable[c] = act_.learned && st_.thresholds(c) >= p_.clip * p_.clip;
+  }
   st_.threshold = act_.threshold.maxCoeff();
   st_.threshold_d = act_.threshold_d.maxCoeff();
   st_.relearning = has_shadow_;

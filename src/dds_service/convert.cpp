@@ -141,6 +141,9 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
       if (s.isolation.awaiting_onset[c]) {
         msg += std::string(c == 0 ? "accelerometer" : "gyro") +
                " residual above its bar since going live: raises nothing until it falls; ";
+      } else if (s.isolation.bar_unreachable[c]) {
+        msg += std::string(c == 0 ? "accelerometer" : "gyro") +
+               " residual bar out of J_N's reach: raises nothing; ";
       }
     }
   }

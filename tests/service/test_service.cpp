@@ -435,6 +435,12 @@ TEST(StatusMessage, SaysWhichChannelAwaitsItsOnset) {
   // AND once it has fallen, nothing is said
   st.isolation.awaiting_onset = {false, false};
   EXPECT_EQ(to_dds(st, 257000001, IsolationParams{}).message().to_string(), "armed; ");
+  // AND a channel whose bar the statistic cannot pass is named too
+  st.isolation.bar_unreachable = {true, true};
+  const std::string both = to_dds(st, 257000001, IsolationParams{}).message().to_string();
+  EXPECT_EQ(both,
+            "armed; accelerometer residual bar out of J_N's reach: raises nothing; gyro residual "
+            "bar out of J_N's reach: raises nothing; ");
 }
 
 TEST(ServiceInProcess, RefusesAMissingMmsiAndAnUnknownProfileByName) {

@@ -2,6 +2,7 @@
 // sections 8.3 and 8.6).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <utility>
@@ -145,6 +146,64 @@ TEST(IsolatorThresholds, WhileTheBarsAreYoungAResidualRaiseIsConfirmedLonger) {
   ASSERT_EQ(longer.size(), 2u);
   EXPECT_NEAR(longer[0] - same[0], p.enter_time, 0.15);
   EXPECT_NEAR(longer[1], same[1], 1e-9);
+}
+
+/// The share of live samples (armed, learned, settled) with each channel's bar flagged
+/// unreachable, the isolation stage given the Otter's A with its second row (a3, a4) scaled by
+/// `yaw_scale` on its healthy course changes.
+Vec2 unreachable_share(double yaw_scale) {
+  VesselModel v;
+  EXPECT_TRUE(find_vessel("otter", &v));
+  SimConfig sim;
+  sim.vessel = v;
+  sim.rate_hz = 10.0;
+  sim.duration = 600.0;
+  sim.seed = 7;
+  Mat2 A = v.A;
+  A(1, 0) *= yaw_scale;
+  A(1, 1) *= yaw_scale;
+  const IsolationParams p;
+  Isolator iso(p, v.B);
+  Estimate est;
+  est.A = A;
+  est.converged = true;
+  est.warming_up = false;
+  est.status = IdentStatus::kConverged;
+  bool given = false;
+  std::vector<Detection> dets;
+  Vec2 flagged = Vec2::Zero();
+  double live = 0.0;
+  for (const SimRow& r : simulate(sim)) {
+    dets.clear();
+    iso.update({r.t, r.v, r.r, r.delta}, &dets);
+    if (!given) {
+      est.t = r.t;
+      iso.set_estimate(est);
+      given = true;
+    }
+    const IsolatorStatus& st = iso.status();
+    if (!st.armed || st.learning || st.settling) continue;
+    live += 1.0;
+    for (int c = 0; c < 2; ++c) {
+      // the flag says exactly that the bar is at or above what J_N can reach
+      EXPECT_EQ(st.bar_unreachable[c], st.thresholds(c) >= p.clip * p.clip);
+      if (st.bar_unreachable[c]) flagged(c) += 1.0;
+    }
+  }
+  EXPECT_GT(live, 0.0);
+  return flagged / std::max(live, 1.0);
+}
+
+TEST(IsolatorThresholds, ABarTheStatisticCannotPassIsFlagged) {
+  // GIVEN the isolation stage on the Otter's healthy course changes
+  // WHEN it has the true A THEN no bar is flagged
+  EXPECT_EQ(unreachable_share(1.0), Vec2::Zero());
+  // WHEN its a3 and a4 are 20 % off, THEN each course change pegs the gyro's J_N, the
+  // healthy maximum reaches the clip, and the gyro's bar stands above clip^2 (flagged) on
+  // nearly all the live samples, the accelerometer's on almost none
+  const Vec2 off = unreachable_share(0.8);
+  EXPECT_GT(off(1), 0.9) << off.transpose();
+  EXPECT_LT(off(0), 0.05) << off.transpose();
 }
 
 TEST(IsolatorThresholds, TheHistoryBarNeverFallsAsTheHealthyMaximumRisesAndStaysReachable) {

@@ -187,6 +187,10 @@ struct IsolatorStatus {
   /// Per channel [accelerometer, gyro]: detection is live but the channel's J_N has been above
   /// its bar ever since, so its residual raises nothing until it falls once (no onset yet).
   std::array<bool, 2> awaiting_onset{};
+  /// Per channel: its bar on J_N is at or above clip^2, which the statistic (a mean of squares
+  /// clipped at +-clip) can never pass: its residual raises nothing while this holds (the
+  /// healthy maximum reached the clip: waves, or a model that does not hold).
+  std::array<bool, 2> bar_unreachable{};
   InputHealth input;
   std::uint64_t samples = 0;
   /// The jump check per channel [accelerometer, gyro] (core/jump_check.hpp).
