@@ -138,7 +138,6 @@ void Isolator::set_estimate(const Estimate& est) {
     st_.armed = true;
     ++st_.designs;
     t_armed_ = t_now;
-    for (ChannelState& ch : chan_) ch.onset_seen = false;
     act_.settle_until = t_armed_ + settle_time_;
     const Vec2 y0(std::isfinite(prev_.v) ? prev_.v : 0.0, std::isfinite(prev_.r) ? prev_.r : 0.0);
     act_.v.reset(y0);
@@ -400,8 +399,7 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   update_confidences();
   if (!act_.learned) return;
   check_spikes(s.t, x.sw, out);
-  Levels lv = levels(s.t, dt);
-  await_onsets(&lv);
+  const Levels lv = levels(s.t, dt);
   const Candidate c = choose_candidate(s.t, lv);
   confirm_candidate(s.t, lv, c, out);
   drift_checks(s.t, dt, x, learn_ok, lv, out);

@@ -143,8 +143,8 @@ TEST(BenchQuick, HarnessWorksAndTheOracleDetectsTheFaults) {
   // when a +-10 deg course change moves the channel by a few sigma only.
   // The linearisation of the open-loop unstable 3-DOF Otter does not hold: the oracle's gyro
   // J_N pegs at clip^2 at every course change, its bar grows past clip^2 and it misses the gyro
-  // bias and drift. Its false alarm right after arming (the rise under way when detection went
-  // live, now kept out by Isolator::await_onsets) is no longer what says so.
+  // bias and drift. Named here rather than inferred from an oracle false alarm, which a change
+  // elsewhere can remove (tried at stop 44: the check then failed on those misses).
   const auto linearisation_holds = [](const std::string& name) {
     return name.rfind("otter3dof", 0) != 0;
   };

@@ -184,9 +184,6 @@ struct IsolatorStatus {
   bool model_mismatch = false;
   std::string mismatch_reason;   ///< why (empty when there is none)
   std::uint64_t mismatches = 0;  ///< verdicts of model mismatch so far
-  /// Per channel [accelerometer, gyro]: detection is live but the channel's J_N has been above
-  /// its bar ever since, so its residual raises nothing until it falls once (no onset yet).
-  std::array<bool, 2> awaiting_onset{};
   /// Per channel: its bar on J_N is at or above clip^2, which the statistic (a mean of squares
   /// clipped at +-clip) can never pass: its residual raises nothing while this holds (the
   /// healthy maximum reached the clip: waves, or a model that does not hold).
@@ -272,10 +269,8 @@ class Isolator {
   /// What the residual evaluation keeps of one INS channel (0: v, the accelerometer's; 1: r,
   /// the gyro's) beside the banks.
   struct ChannelState {
-    bool resync = false;           ///< restart the channel's own observer (cleared)
-    double resettle_until = kNaN;  ///< the restarted observer settles
-    /// Its J_N seen at or below its enter threshold since arming: a sensor fault has an onset.
-    bool onset_seen = false;
+    bool resync = false;                           ///< restart the channel's own observer (cleared)
+    double resettle_until = kNaN;                  ///< the restarted observer settles
     std::deque<std::pair<double, double>> hist_s;  ///< (t, whitened structured residual)
     std::deque<std::pair<double, double>> hist_d;  ///< (t, raw cross residual)
     std::deque<std::pair<double, double>> hist_x;  ///< (t, other-observer state)
@@ -374,7 +369,6 @@ class Isolator {
   struct Levels {
     Vec2 thr = Vec2::Zero();         ///< enter thresholds on J_N
     Vec2 ratio = Vec2::Zero();       ///< J_N / thr (0 while a window refills or resettles)
-    bool live[2] = {true, true};     ///< ratio(c) is from a full window, settled
     Vec2 thr_exit_d = Vec2::Zero();  ///< leave thresholds on D_N
     std::size_t n_full = 0;          ///< samples in a full window
   };
@@ -401,8 +395,6 @@ class Isolator {
   void update_confidences();
   void check_spikes(double t, const Vec2& sw, std::vector<Detection>* out);
   Levels levels(double t, double dt) const;
-  /// Keeps a channel that has not been at or below its bar since arming out of the levels.
-  void await_onsets(Levels* lv);
   Candidate choose_candidate(double t, const Levels& lv);
   void confirm_candidate(double t, const Levels& lv, const Candidate& c,
                          std::vector<Detection>* out);
