@@ -324,14 +324,7 @@ function connect() {
   es.onopen = () => { link.textContent = 'live'; link.className = 'link up'; };
   es.onmessage = (m) => {
     const msg = JSON.parse(m.data);
-    if (msg.delta && board && msg.revision !== board.revision + 1) {
-      // A delta missed (or one from before the board we have): the board would drift from the
-      // dashboard's. A new stream starts with the whole board.
-      es.close();
-      link.textContent = 'reconnecting'; link.className = 'link down';
-      connect();
-      return;
-    }
+    if (board && reopenOnMissedDelta(msg, board.revision, es, link, connect)) return;
     if (msg.delta && board) {
       applyDelta(msg);
     } else {

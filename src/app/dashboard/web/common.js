@@ -29,3 +29,16 @@ function age(s) {
   return Math.floor(s / 3600) + ' h ' + Math.floor((s % 3600) / 60) + ' min';
 }
 function utc(t) { return t === null ? '–' : new Date(t * 1000).toISOString().replace('T', ' ').slice(0, 23); }
+
+// A delta other than the next one after `revision` (BoardFrame in src/app/dashboard/board.hpp):
+// a board put together from it would drift from the dashboard's. Closes the stream and opens a
+// new one (connect), which starts with the whole board; true when it did.
+function reopenOnMissedDelta(msg, revision, es, link, connect) {
+  if (!msg.delta || revision === null || revision === undefined || msg.revision === revision + 1) {
+    return false;
+  }
+  es.close();
+  link.textContent = 'reconnecting'; link.className = 'link down';
+  connect();
+  return true;
+}

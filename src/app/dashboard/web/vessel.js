@@ -124,13 +124,7 @@ function connect() {
   let revision = null;  // the board's (BoardFrame in src/app/dashboard/board.hpp)
   es.onmessage = (m) => {
     const board = JSON.parse(m.data);
-    if (board.delta && revision !== null && board.revision !== revision + 1) {
-      // a delta missed: a new stream starts with the whole board
-      es.close();
-      link.textContent = 'reconnecting'; link.className = 'link down';
-      connect();
-      return;
-    }
+    if (reopenOnMissedDelta(board, revision, es, link, connect)) return;
     revision = board.revision;
     const mine = board.vessels.find((x) => x.mmsi === mmsi);
     if (!board.delta || mine) {
