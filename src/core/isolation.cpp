@@ -58,6 +58,8 @@ void IsolationParams::validate() const {
           "exit_ratio * threshold must exceed 1 (healthy J_N is about 1)");
   require(enter_time >= 0, "enter_time", enter_time, "must be >= 0");
   require(young_enter_ratio >= 1, "young_enter_ratio", young_enter_ratio, "must be >= 1");
+  require(onset_lookback >= 0 && onset_lookback <= 600, "onset_lookback", onset_lookback,
+          "must be in [0, 600] s");
   require(leave_time >= 0, "leave_time", leave_time, "must be >= 0");
   require(second_fault_time >= 0, "second_fault_time", second_fault_time, "must be >= 0");
   require(mismatch_window >= 0, "mismatch_window", mismatch_window, "must be >= 0");
@@ -138,6 +140,7 @@ void Isolator::set_estimate(const Estimate& est) {
     st_.armed = true;
     ++st_.designs;
     t_armed_ = t_now;
+    for (ChannelState& ch : chan_) ch.onset_seen = false;
     act_.settle_until = t_armed_ + settle_time_;
     const Vec2 y0(std::isfinite(prev_.v) ? prev_.v : 0.0, std::isfinite(prev_.r) ? prev_.r : 0.0);
     act_.v.reset(y0);
@@ -399,7 +402,8 @@ void Isolator::residual_checks(const Sample& s, double dt, std::vector<Detection
   update_confidences();
   if (!act_.learned) return;
   check_spikes(s.t, x.sw, out);
-  const Levels lv = levels(s.t, dt);
+  Levels lv = levels(s.t, dt);
+  await_onsets(&lv);
   const Candidate c = choose_candidate(s.t, lv);
   confirm_candidate(s.t, lv, c, out);
   drift_checks(s.t, dt, x, learn_ok, lv, out);

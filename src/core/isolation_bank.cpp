@@ -117,6 +117,21 @@ double Isolator::learned_threshold(std::vector<double>* healthy) const {
                   reachable_threshold());
 }
 
+bool onset_before_live(const std::vector<double>& J, std::size_t back, double threshold) {
+  // J_N at or below the threshold within the last `back` samples, and the samples before
+  // them quiet (at most 1 % above it): a rise began from a quiet state just before going
+  // live (the paper's gyro bias 0.9 s before). A channel the waves take over the threshold
+  // again and again while it learns (the 3-DOF Otter in sea state 3: pegged at the clip
+  // every few seconds, its threshold capped at 0.75 clip^2) has no quiet state to begin from.
+  if (J.empty()) return false;
+  const std::size_t from = J.size() > back ? J.size() - back : 0;
+  bool below = false;
+  for (std::size_t i = from; i < J.size(); ++i) below = below || J[i] <= threshold;
+  std::size_t above = 0;
+  for (std::size_t i = 0; i < from; ++i) above += J[i] > threshold ? 1 : 0;
+  return below && 100 * above <= from;
+}
+
 double history_bar(double healthy_max, double margin, double clip) {
   // A windowed mean of clipped squares saturates at clip^2; a bar at or above it made the
   // channel blind without a word (a gyro drift of 10 sigma in 10 s on the Otter was never
@@ -240,8 +255,14 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
       b->learned_time += dt;
     }
     if (b->learned_time >= 0.5 * p_.learn_time) {
+      // The last learning samples that count as just before going live.
+      const std::size_t back =
+          static_cast<std::size_t>(std::ceil(p_.onset_lookback / std::max(dt, 1e-6)));
       for (int c = 0; c < 2; ++c) {
+        // A copy in learning order: learned_threshold reorders the samples.
+        const std::vector<double> J = b->learn_J[c];
         b->threshold(c) = learned_threshold(&b->learn_J[c]);
+        b->onset_in_learning[c] = onset_before_live(J, back, b->threshold(c));
         b->threshold_d(c) = learned_threshold(&b->learn_D[c]);
         std::vector<double>().swap(b->learn_J[c]);
         std::vector<double>().swap(b->learn_D[c]);

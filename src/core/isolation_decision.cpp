@@ -139,10 +139,33 @@ Isolator::Levels Isolator::levels(double t, double dt) const {
   lv.ratio = st_.J.cwiseQuotient(lv.thr);  // > 1: above the enter threshold
   for (int c = 0; c < 2; ++c) {
     // refilling or settling after a fault cleared
-    if (act_.win_s[c].size() < lv.n_full || t < chan_[c].resettle_until) lv.ratio(c) = 0.0;
+    if (act_.win_s[c].size() < lv.n_full || t < chan_[c].resettle_until) {
+      lv.ratio(c) = 0.0;
+      lv.live[c] = false;
+    }
   }
   lv.thr_exit_d = p_.exit_ratio * st_.thresholds_d;
   return lv;
+}
+
+void Isolator::await_onsets(Levels* lv) {
+  // A channel whose statistic is above its bar from the moment detection went live has shown
+  // no onset: nothing began that a sensor fault would have begun. It is what the model does
+  // not hold in what the vessel was doing when it armed (the Otter armed in a zigzag, its yaw
+  // residual pegged for a minute before arming, was raised 1.5 enter_time after it: 7 of the
+  // proving ground's 46 false alarms). Such a channel raises nothing until it has been seen
+  // at or below its bar once, as while it settles. A rise that began from a quiet learning
+  // window within onset_lookback before going live is an onset all the same
+  // (onset_before_live): the paper's gyro bias starts at 20.0 s, 0.9 s before learning ends.
+  for (int c = 0; c < 2; ++c) {
+    if (lv->live[c] && (lv->ratio(c) <= 1.0 || act_.onset_in_learning[c]))
+      chan_[c].onset_seen = true;
+    st_.awaiting_onset[c] = lv->live[c] && !chan_[c].onset_seen;
+    if (!chan_[c].onset_seen) {
+      lv->ratio(c) = 0.0;
+      lv->live[c] = false;
+    }
+  }
 }
 
 Isolator::Candidate Isolator::choose_candidate(double t, const Levels& lv) {

@@ -136,9 +136,12 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
     msg += "armed, learning healthy statistics; ";
   } else {
     msg += "armed; ";
-    // (said: while it holds the channel's residual path can raise nothing)
+    // (said, because the channel's residual path is closed until then)
     for (int c = 0; c < 2; ++c) {
-      if (s.isolation.bar_unreachable[c]) {
+      if (s.isolation.awaiting_onset[c]) {
+        msg += std::string(c == 0 ? "accelerometer" : "gyro") +
+               " residual above its bar since going live: raises nothing until it falls; ";
+      } else if (s.isolation.bar_unreachable[c]) {
         msg += std::string(c == 0 ? "accelerometer" : "gyro") +
                " residual bar out of J_N's reach: raises nothing; ";
       }

@@ -105,6 +105,51 @@ void expect_no_raise(const MethodResult& r) {
   }
 }
 
+TEST(BenchDrivers, AResidualAboveItsBarWhenDetectionGoesLiveIsNotRaised) {
+  // GIVEN a proving-ground run (the Otter, 10 Hz, sea state 3) that arms at 901 s in the
+  // middle of a +-20 deg zigzag the linear model does not hold: the gyro's J_N has been pegged
+  // at clip^2 since 881 s, above its bar from the first live sample on, and falls at 907.9 s
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick = proving_ground_run("otter @ 10 Hz", "voyage/sea3/mems",
+                                                      14519301653455217402ull, true, &engine_cfg);
+  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
+  const Stream data = pick->make();
+  const MethodResult r = run_engine(engine_cfg, data.samples);
+  ASSERT_TRUE(std::isfinite(r.t_armed));
+  ASSERT_GT(r.t_armed, 895.0);
+  ASSERT_LT(r.t_armed, 904.0);
+  // THEN nothing is raised before the injected fault (an accelerometer scale error from 975 s):
+  // the rise began before detection went live, so it is not a sensor's onset (up to stop 43
+  // the gyro was raised at 904.8 s, 1.5 enter_time after arming, and cleared 3 s later)
+  for (const Alarm& a : r.alarms) {
+    if (a.raised && a.t < pick->fault.t_start) {
+      ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
+    }
+  }
+  // AND the status says so while it lasts: the gyro awaits its onset from the first live
+  // sample until its J_N falls (907.9 s); the accelerometer, below its bar, does not
+  FdiEngine engine(engine_cfg);
+  std::vector<FaultEvent> events;
+  double first = kNaN, last = kNaN;
+  bool accelerometer = false;
+  for (const Sample& s : data.samples) {
+    if (s.t > 960.0) break;
+    events.clear();
+    engine.process(s, &events);
+    const IsolatorStatus& st = engine.isolation_status();
+    if (st.awaiting_onset[1]) {
+      if (std::isnan(first)) first = s.t;
+      last = s.t;
+    }
+    accelerometer = accelerometer || st.awaiting_onset[0];
+  }
+  ASSERT_TRUE(std::isfinite(first));
+  EXPECT_NEAR(first, r.t_armed, 0.5);
+  EXPECT_GT(last, 905.0);
+  EXPECT_LT(last, 909.0);
+  EXPECT_FALSE(accelerometer);
+}
+
 TEST(BenchDrivers, ABiasTheJumpCheckRaisedIsNotShownRectifiedBeforeHoldMax) {
   // GIVEN a proving-ground run (Esso Osaka, 50 Hz, calm course changes) with a 10 sigma
   // accelerometer bias on [1106.1, 1166.1) s, raised by the jump check once the observers are

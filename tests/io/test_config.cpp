@@ -86,6 +86,7 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.exit_ratio, q.exit_ratio);
   EXPECT_EQ(p.enter_time, q.enter_time);
   EXPECT_EQ(p.young_enter_ratio, q.young_enter_ratio);
+  EXPECT_EQ(p.onset_lookback, q.onset_lookback);
   EXPECT_EQ(p.leave_time, q.leave_time);
   EXPECT_EQ(p.second_fault_time, q.second_fault_time);
   EXPECT_EQ(p.mismatch_window, q.mismatch_window);
@@ -218,6 +219,7 @@ isolation:
   history: 1200
   second_fault_time: 3.5
   young_enter_ratio: 1.25
+  onset_lookback: 2.5
   resume_after_fault: 4.5
 jump:
   enabled: false
@@ -265,6 +267,7 @@ service:
   EXPECT_EQ(c.identification.guard_recent_time, 90.0);
   EXPECT_EQ(c.isolation.second_fault_time, 3.5);
   EXPECT_EQ(c.isolation.young_enter_ratio, 1.25);
+  EXPECT_EQ(c.isolation.onset_lookback, 2.5);
   EXPECT_EQ(c.isolation.resume_after_fault, 4.5);
   EXPECT_FALSE(c.isolation.jump.enabled);
   EXPECT_EQ(c.isolation.jump.pre_window, 2.0);

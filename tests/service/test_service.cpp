@@ -420,19 +420,25 @@ TEST(ServiceInProcess, StopWhileFloodedJoinsPromptly) {
               static_cast<unsigned long long>(st.dropped_inputs));
 }
 
-TEST(StatusMessage, SaysWhichChannelsBarTheStatisticCannotPass) {
-  // GIVEN a live detector whose bars J_N can reach
+TEST(StatusMessage, SaysWhichChannelAwaitsItsOnset) {
+  // GIVEN a live detector whose gyro residual has been above its bar since it went live
   pipeline::PipelineStatus st;
   st.isolation.armed = true;
-  // THEN nothing is said of them
+  st.isolation.awaiting_onset = {false, true};
+  // THEN the status says so, within the message's 127 characters
+  const std::string msg = to_dds(st, 257000001, IsolationParams{}).message().to_string();
+  EXPECT_NE(msg.find("gyro residual above its bar since going live: raises nothing until it "
+                     "falls"),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(msg.find("accelerometer residual"), std::string::npos) << msg;
+  // AND once it has fallen, nothing is said
+  st.isolation.awaiting_onset = {false, false};
   EXPECT_EQ(to_dds(st, 257000001, IsolationParams{}).message().to_string(), "armed; ");
-  // WHEN the gyro's bar stands at or above clip^2, THEN the status names it alone
-  st.isolation.bar_unreachable = {false, true};
-  EXPECT_EQ(to_dds(st, 257000001, IsolationParams{}).message().to_string(),
-            "armed; gyro residual bar out of J_N's reach: raises nothing; ");
-  // AND both channels fit within the message's 127 characters
+  // AND a channel whose bar the statistic cannot pass is named too
   st.isolation.bar_unreachable = {true, true};
-  EXPECT_EQ(to_dds(st, 257000001, IsolationParams{}).message().to_string(),
+  const std::string both = to_dds(st, 257000001, IsolationParams{}).message().to_string();
+  EXPECT_EQ(both,
             "armed; accelerometer residual bar out of J_N's reach: raises nothing; gyro residual "
             "bar out of J_N's reach: raises nothing; ");
 }

@@ -229,6 +229,32 @@ TEST(IsolatorThresholds, TheHistoryBarNeverFallsAsTheHealthyMaximumRisesAndStays
   }
 }
 
+TEST(IsolatorThresholds, AnOnsetBeforeGoingLiveNeedsARecentQuietSampleAndAQuietPast) {
+  const double thr = 12.0;
+  const std::size_t back = 50;
+  // GIVEN 300 learning values of J_N at 1 (quiet) ...
+  std::vector<double> J(300, 1.0);
+  // ... WHEN the last 9 rise to the clip (a fault that began 0.9 s before going live)
+  std::fill(J.end() - 9, J.end(), 16.0);
+  // THEN it is an onset
+  EXPECT_TRUE(onset_before_live(J, back, thr));
+  // WHEN the rise covers the whole look-back, THEN it is not (no quiet sample in it)
+  std::fill(J.end() - static_cast<std::ptrdiff_t>(back), J.end(), 16.0);
+  EXPECT_FALSE(onset_before_live(J, back, thr));
+  // WHEN the past was pegged every few seconds (waves), 3 of its 250 values above the bar,
+  // THEN a recent dip is not an onset from a quiet state
+  std::vector<double> waves(300, 1.0);
+  for (std::size_t i = 10; i < 250; i += 80) waves[i] = 16.0;
+  waves.back() = 16.0;
+  EXPECT_FALSE(onset_before_live(waves, back, thr));
+  // WHEN 2 of the 250 are above (within 1 %), THEN it still is
+  waves[10] = 1.0;
+  EXPECT_TRUE(onset_before_live(waves, back, thr));
+  // AND a value equal to the bar counts as at or below it; nothing learned is no onset
+  std::vector<double> at(100, thr);
+  EXPECT_TRUE(onset_before_live(at, back, thr));
+  EXPECT_FALSE(onset_before_live({}, back, thr));
+}
 TEST(IsolatorKinds, AFrozenOutputIsNamedStuckWhateverRaisedItFirst) {
   // GIVEN a gyro that moves (a slow swing and white noise), then jumps by 20 sigma and
   // freezes at 100 s: the jump check raises it before the stuck check has seen enough

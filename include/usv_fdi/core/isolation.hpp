@@ -71,6 +71,13 @@ struct IsolationParams {
   /// 1.5 with the history bar that never falls (history_bar): docs/benchmark.md, "The
   /// history bar" [-]
   double young_enter_ratio = 1.5;
+  /// A channel whose J_N is above its bar from the moment detection goes live raises nothing
+  /// until it has been at or below it (no onset: what the model does not hold in what the
+  /// vessel was doing when it armed), unless its J_N was at or below the bar just learned
+  /// within this long before going live and quiet before that (above the bar on at most 1 %
+  /// of the learning samples): a fault that began in the last seconds of learning (the
+  /// paper's gyro bias, 0.9 s before) keeps its onset [s]
+  double onset_lookback = 5.0;
   double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
@@ -184,6 +191,9 @@ struct IsolatorStatus {
   bool model_mismatch = false;
   std::string mismatch_reason;   ///< why (empty when there is none)
   std::uint64_t mismatches = 0;  ///< verdicts of model mismatch so far
+  /// Per channel [accelerometer, gyro]: detection is live but the channel's J_N has been above
+  /// its bar ever since, so its residual raises nothing until it falls once (no onset yet).
+  std::array<bool, 2> awaiting_onset{};
   /// Per channel: its bar on J_N is at or above clip^2, which the statistic (a mean of squares
   /// clipped at +-clip) can never pass: its residual raises nothing while this holds (the
   /// healthy maximum reached the clip: waves, or a model that does not hold).
@@ -205,6 +215,11 @@ struct IsolatorStatus {
 /// larger of the knee and 1.05 x healthy_max. Non-decreasing in healthy_max, and below
 /// clip^2 (a fault that pegs the statistic is still raised) while 1.05 x healthy_max < clip^2.
 double history_bar(double healthy_max, double margin, double clip);
+
+/// Whether the J_N a bank learned (J, in time order) shows an onset just before going live:
+/// at or below threshold within its last `back` samples, and above it on at most 1 % of the
+/// samples before them (Isolator::await_onsets; IsolationParams::onset_lookback).
+bool onset_before_live(const std::vector<double>& J, std::size_t back, double threshold);
 
 class Isolator {
  public:
@@ -269,8 +284,10 @@ class Isolator {
   /// What the residual evaluation keeps of one INS channel (0: v, the accelerometer's; 1: r,
   /// the gyro's) beside the banks.
   struct ChannelState {
-    bool resync = false;                           ///< restart the channel's own observer (cleared)
-    double resettle_until = kNaN;                  ///< the restarted observer settles
+    bool resync = false;           ///< restart the channel's own observer (cleared)
+    double resettle_until = kNaN;  ///< the restarted observer settles
+    /// Its J_N seen at or below its enter threshold since arming: a sensor fault has an onset.
+    bool onset_seen = false;
     std::deque<std::pair<double, double>> hist_s;  ///< (t, whitened structured residual)
     std::deque<std::pair<double, double>> hist_d;  ///< (t, raw cross residual)
     std::deque<std::pair<double, double>> hist_x;  ///< (t, other-observer state)
@@ -325,7 +342,9 @@ class Isolator {
     // scales unless it covers half of the learning time).
     std::array<std::vector<double>, 4> learn_raw;         ///< s_a, s_g, d_a, d_g raw residuals
     std::array<std::vector<double>, 2> learn_J, learn_D;  ///< per channel
-    std::array<Window, 2> win_s;                          ///< clipped squared structured residuals
+    /// Per channel: an onset just before going live (onset_before_live on learn_J).
+    std::array<bool, 2> onset_in_learning{};
+    std::array<Window, 2> win_s;   ///< clipped squared structured residuals
     std::array<Window, 2> win_sl;  ///< signed structured residuals (classification)
     std::array<Window, 2> win_d;   ///< clipped squared cross residuals
     Vec2 J = Vec2::Zero(), D = Vec2::Zero();
@@ -369,6 +388,7 @@ class Isolator {
   struct Levels {
     Vec2 thr = Vec2::Zero();         ///< enter thresholds on J_N
     Vec2 ratio = Vec2::Zero();       ///< J_N / thr (0 while a window refills or resettles)
+    bool live[2] = {true, true};     ///< ratio(c) is from a full window, settled
     Vec2 thr_exit_d = Vec2::Zero();  ///< leave thresholds on D_N
     std::size_t n_full = 0;          ///< samples in a full window
   };
@@ -395,6 +415,8 @@ class Isolator {
   void update_confidences();
   void check_spikes(double t, const Vec2& sw, std::vector<Detection>* out);
   Levels levels(double t, double dt) const;
+  /// Keeps a channel that has not been at or below its bar since arming out of the levels.
+  void await_onsets(Levels* lv);
   Candidate choose_candidate(double t, const Levels& lv);
   void confirm_candidate(double t, const Levels& lv, const Candidate& c,
                          std::vector<Detection>* out);
