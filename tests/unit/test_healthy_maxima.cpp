@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <utility>
 #include <vector>
@@ -41,27 +42,28 @@ TEST(HealthyMaxima, AreTheLargestValuesOfTheHistoryAndForgetOlderBlocks) {
   EXPECT_TRUE(h.empty());
 }
 
-/// Raises of the isolation stage given A (an oracle) on the Otter's healthy course changes,
-/// with the hull's true A off by 20 % in a3 and a4: every course change carries model
-/// mismatch of the same size.
-int raises_after(const IsolationParams& p, double after) {
-  VesselModel v;
-  EXPECT_TRUE(find_vessel("otter", &v));
+/// The shipped Otter's healthy course changes at 10 Hz (core/simulator.hpp), for `duration`
+/// seconds from `seed`.
+SimConfig otter_course_changes(double duration, std::uint64_t seed) {
   SimConfig sim;
-  sim.vessel = v;
+  EXPECT_TRUE(find_vessel("otter", &sim.vessel));
   sim.rate_hz = 10.0;
-  sim.duration = 1500.0;
-  sim.seed = 3;
-  Mat2 A = v.A;
-  A(1, 0) *= 0.8;
-  A(1, 1) *= 0.8;
-  Isolator iso(p, v.B);
+  sim.duration = duration;
+  sim.seed = seed;
+  return sim;
+}
+
+/// Runs the isolation stage given A from the first sample on (an oracle: a converged
+/// estimate) over the simulated run, and calls each(row, detections, status) after every
+/// sample.
+template <typename Each>
+void run_given_A(const IsolationParams& p, const Mat2& A, const SimConfig& sim, Each each) {
+  Isolator iso(p, sim.vessel.B);
   Estimate est;
   est.A = A;
   est.converged = true;
   est.warming_up = false;
   est.status = IdentStatus::kConverged;
-  int raises = 0;
   bool given = false;
   std::vector<Detection> dets;
   for (const SimRow& r : simulate(sim)) {
@@ -72,8 +74,29 @@ int raises_after(const IsolationParams& p, double after) {
       iso.set_estimate(est);
       given = true;
     }
-    for (const Detection& d : dets) raises += d.active && !d.update && r.t > after;
+    each(r, dets, iso.status());
   }
+}
+
+/// The Otter's A with its second row (a3, a4) scaled by `yaw_scale`.
+Mat2 otter_A_yaw_scaled(double yaw_scale) {
+  VesselModel v;
+  EXPECT_TRUE(find_vessel("otter", &v));
+  Mat2 A = v.A;
+  A(1, 0) *= yaw_scale;
+  A(1, 1) *= yaw_scale;
+  return A;
+}
+
+/// Raises of the isolation stage given A (an oracle) on the Otter's healthy course changes,
+/// with the hull's true A off by 20 % in a3 and a4: every course change carries model
+/// mismatch of the same size.
+int raises_after(const IsolationParams& p, double after) {
+  int raises = 0;
+  run_given_A(p, otter_A_yaw_scaled(0.8), otter_course_changes(1500.0, 3),
+              [&](const SimRow& r, const std::vector<Detection>& dets, const IsolatorStatus&) {
+                for (const Detection& d : dets) raises += d.active && !d.update && r.t > after;
+              });
   return raises;
 }
 
@@ -95,37 +118,17 @@ TEST(IsolatorThresholds, AModelMismatchMetInHealthyManoeuvresRaisesTheBar) {
 /// true A (an oracle), with a gyro drift injected on each of the given intervals.
 std::vector<double> gyro_raises(const IsolationParams& p,
                                 const std::vector<std::pair<double, double>>& drifts) {
-  VesselModel v;
-  EXPECT_TRUE(find_vessel("otter", &v));
-  SimConfig sim;
-  sim.vessel = v;
-  sim.rate_hz = 10.0;
-  sim.duration = 1000.0;
-  sim.seed = 5;
+  SimConfig sim = otter_course_changes(1000.0, 5);
   for (const auto& [from, to] : drifts) {
     sim.faults.push_back({Sensor::kGyro, FaultKind::kDrift, from, to, 0.002});
   }
-  Isolator iso(p, v.B);
-  Estimate est;
-  est.A = v.A;
-  est.converged = true;
-  est.warming_up = false;
-  est.status = IdentStatus::kConverged;
   std::vector<double> raises;
-  bool given = false;
-  std::vector<Detection> dets;
-  for (const SimRow& r : simulate(sim)) {
-    dets.clear();
-    iso.update({r.t, r.v, r.r, r.delta}, &dets);
-    if (!given) {
-      est.t = r.t;
-      iso.set_estimate(est);
-      given = true;
-    }
-    for (const Detection& d : dets) {
-      if (d.sensor == Sensor::kGyro && d.active && !d.update) raises.push_back(r.t);
-    }
-  }
+  run_given_A(p, sim.vessel.A, sim,
+              [&](const SimRow& r, const std::vector<Detection>& dets, const IsolatorStatus&) {
+                for (const Detection& d : dets) {
+                  if (d.sensor == Sensor::kGyro && d.active && !d.update) raises.push_back(r.t);
+                }
+              });
   return raises;
 }
 
@@ -152,44 +155,19 @@ TEST(IsolatorThresholds, WhileTheBarsAreYoungAResidualRaiseIsConfirmedLonger) {
 /// unreachable, the isolation stage given the Otter's A with its second row (a3, a4) scaled by
 /// `yaw_scale` on its healthy course changes.
 Vec2 unreachable_share(double yaw_scale) {
-  VesselModel v;
-  EXPECT_TRUE(find_vessel("otter", &v));
-  SimConfig sim;
-  sim.vessel = v;
-  sim.rate_hz = 10.0;
-  sim.duration = 600.0;
-  sim.seed = 7;
-  Mat2 A = v.A;
-  A(1, 0) *= yaw_scale;
-  A(1, 1) *= yaw_scale;
   const IsolationParams p;
-  Isolator iso(p, v.B);
-  Estimate est;
-  est.A = A;
-  est.converged = true;
-  est.warming_up = false;
-  est.status = IdentStatus::kConverged;
-  bool given = false;
-  std::vector<Detection> dets;
   Vec2 flagged = Vec2::Zero();
   double live = 0.0;
-  for (const SimRow& r : simulate(sim)) {
-    dets.clear();
-    iso.update({r.t, r.v, r.r, r.delta}, &dets);
-    if (!given) {
-      est.t = r.t;
-      iso.set_estimate(est);
-      given = true;
-    }
-    const IsolatorStatus& st = iso.status();
-    if (!st.armed || st.learning || st.settling) continue;
-    live += 1.0;
-    for (int c = 0; c < 2; ++c) {
-      // the flag says exactly that the bar is at or above what J_N can reach
-      EXPECT_EQ(st.bar_unreachable[c], st.thresholds(c) >= p.clip * p.clip);
-      if (st.bar_unreachable[c]) flagged(c) += 1.0;
-    }
-  }
+  run_given_A(p, otter_A_yaw_scaled(yaw_scale), otter_course_changes(600.0, 7),
+              [&](const SimRow&, const std::vector<Detection>&, const IsolatorStatus& st) {
+                if (!st.armed || st.learning || st.settling) return;
+                live += 1.0;
+                for (int c = 0; c < 2; ++c) {
+                  // the flag says exactly that the bar is at or above what J_N can reach
+                  EXPECT_EQ(st.bar_unreachable[c], st.thresholds(c) >= p.clip * p.clip);
+                  if (st.bar_unreachable[c]) flagged(c) += 1.0;
+                }
+              });
   EXPECT_GT(live, 0.0);
   return flagged / std::max(live, 1.0);
 }
