@@ -44,6 +44,7 @@ void JumpParams::validate() const {
   require(noise_threshold > 1, "noise_threshold", noise_threshold, "must be > 1");
   require(margin >= 1, "margin", margin, "must be >= 1");
   require(noise_window > 0, "noise_window", noise_window, "must be > 0");
+  require(noise_min_samples >= 4, "noise_min_samples", noise_min_samples, "must be >= 4");
   require(learn_time >= 0, "learn_time", learn_time, "must be >= 0");
   require(history >= kBlock, "history", history, "must be >= 10 s");
   require(scale_time > 0, "scale_time", scale_time, "must be > 0");
@@ -191,7 +192,8 @@ void JumpCheck::resize_windows() {
   pending_.assign(static_cast<std::size_t>(M_), Pending{});
   pending_head_ = pending_n_ = 0;
   const auto w = static_cast<std::size_t>(
-      std::max<long>(2L * p_.min_samples, std::lround(p_.noise_window / dt_)));
+      std::max<long>({2L * p_.min_samples, static_cast<long>(p_.noise_min_samples),
+                      std::lround(p_.noise_window / dt_)}));
   d2_.assign(w, 0.0);
 }
 

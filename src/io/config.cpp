@@ -362,6 +362,7 @@ class Loader {
         {"noise_threshold", number_into(&jp->noise_threshold, {1, 1e6, ""})},
         {"margin", number_into(&jp->margin, {1, 100, ""})},
         {"noise_window", number_into(&jp->noise_window, {0, 60, "s"})},
+        {"noise_min_samples", integer_into(&jp->noise_min_samples, {4, 10000, ""})},
         {"learn_time", number_into(&jp->learn_time, {0, 24 * kHour, "s"})},
         {"history", number_into(&jp->history, {10, 100 * kHour, "s"})},
         {"scale_time", number_into(&jp->scale_time, {0, 24 * kHour, "s"})},

@@ -113,6 +113,7 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(j.noise_threshold, k.noise_threshold);
   EXPECT_EQ(j.margin, k.margin);
   EXPECT_EQ(j.noise_window, k.noise_window);
+  EXPECT_EQ(j.noise_min_samples, k.noise_min_samples);
   EXPECT_EQ(j.learn_time, k.learn_time);
   EXPECT_EQ(j.history, k.history);
   EXPECT_EQ(j.scale_time, k.scale_time);

@@ -127,6 +127,33 @@ TEST(JumpCheck, ANoiseRiseIsANoiseRiseNotAJump) {
   }
 }
 
+TEST(JumpCheck, TheNoiseStatisticHasEnoughSamplesAtTenHertz) {
+  // GIVEN two days of healthy white noise at 10 Hz: the proving ground's 10 Hz voyages raised
+  // a noise rise every hundred hours or so, each a chance run of second differences in a
+  // window of 10 (7 once the three largest are dropped) taking the statistic past its bar
+  Channel c;
+  c.rate = 10.0;
+  const auto samples_above_floor = [&](const JumpParams& p) {
+    int above = 0;
+    for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+      c.seed = seed;
+      JumpCheck check(p, kB, 1e-4);
+      for (const Row& r : channel(c, 24 * 3600.0, [](double, long) { return 0.0; })) {
+        check.update(r.t, r.y, r.delta, !check.jump_raised());
+        above += check.noise_statistic() > p.noise_threshold;
+      }
+    }
+    return above;
+  };
+  JumpParams ten;
+  ten.noise_min_samples = 10;
+  // THEN over a window of 10 samples the statistic passes the bar's floor on healthy data
+  // (the cause, kept in view)
+  EXPECT_GT(samples_above_floor(ten), 0);
+  // AND over the default of at least 20 it never does
+  EXPECT_EQ(samples_above_floor(JumpParams{}), 0);
+}
+
 TEST(JumpCheck, OutliersAreNeitherJumpsNorNoise) {
   // GIVEN single-sample outliers of 30 sigma every 5 s
   Channel c;
