@@ -190,6 +190,13 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   for (const SensorState& x : sens_) faulty = faulty || x.cond.active;
   suspect = suspect || faulty;
   if (faulty) t_last_fault_ = s.t;
+  if (faulty && !was_faulty_ && has_shadow_ && !shadow_.learned && p_.relearn_after_raise) {
+    // A redesign still learning restarts: what it learned just before this raise may hold
+    // the fault's onset (a drift grows for seconds before it is raised), and a learned bar
+    // or scale on it hides the next faults until the design after.
+    restart_learning(&shadow_);
+  }
+  was_faulty_ = faulty;
   if (st_.armed && !st_.learning && !st_.settling) {
     suspect = suspect || (st_.J.array() > p_.exit_ratio * st_.thresholds.array()).any() ||
               (st_.D.array() > p_.exit_ratio * st_.thresholds_d.array()).any() ||

@@ -102,7 +102,18 @@ void Isolator::publish_bank() {
   st_.relearning = has_shadow_;
 }
 
+void Isolator::restart_learning(Bank* b) {
+  b->learned_time = 0.0;
+  b->scales_learned = false;
+  for (auto& v : b->learn_raw) std::vector<double>().swap(v);
+  for (auto& v : b->learn_J) std::vector<double>().swap(v);
+  for (auto& v : b->learn_D) std::vector<double>().swap(v);
+}
+
 double Isolator::reachable_threshold() const { return 0.75 * p_.clip * p_.clip; }
+
+// A closed bar: above clip^2, which a windowed mean of squares clipped at +-clip never passes.
+constexpr double Isolator::kClosedBar;
 
 double Isolator::learned_threshold(std::vector<double>* healthy) const {
   // The median, the MAD about it and the 99.9 % quantile (the value a sort would put at rank
@@ -262,6 +273,19 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
         // A copy in learning order: learned_threshold reorders the samples.
         const std::vector<double> J = b->learn_J[c];
         b->threshold(c) = learned_threshold(&b->learn_J[c]);
+        // A bar that had to be capped to stay within J_N's reach belongs to a residual the
+        // model does not explain: its healthy J_N already went where a fault would take it.
+        // Such a channel is closed (bar_unreachable) until a new design learns again: capped,
+        // it was raised at the hull's next excursion (the Otter in sea state 3, 30-60 s after
+        // going live; a Mariner at 50 Hz whose accelerometer J_N sat at the clip for 216 s).
+        // Judged on the learning before the onset look-back: a fault that began in the last
+        // seconds of learning (the paper's gyro bias) caps the bar too, and keeps its onset.
+        if (p_.close_capped_bars && b->threshold(c) >= reachable_threshold() && J.size() > back) {
+          std::vector<double> past(J.begin(), J.end() - static_cast<std::ptrdiff_t>(back));
+          if (learned_threshold(&past) >= reachable_threshold()) {
+            b->threshold(c) = kClosedBar * p_.clip * p_.clip;
+          }
+        }
         b->onset_in_learning[c] = onset_before_live(J, back, b->threshold(c));
         b->threshold_d(c) = learned_threshold(&b->learn_D[c]);
         std::vector<double>().swap(b->learn_J[c]);

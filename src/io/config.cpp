@@ -319,6 +319,8 @@ class Loader {
         {"enter_time", number_into(&is->enter_time, {0, 60, "s"})},
         {"young_enter_ratio", number_into(&is->young_enter_ratio, {1, 100, ""})},
         {"onset_lookback", number_into(&is->onset_lookback, {0, 600, "s"})},
+        {"close_capped_bars", boolean_into(&is->close_capped_bars)},
+        {"relearn_after_raise", boolean_into(&is->relearn_after_raise)},
         {"leave_time", number_into(&is->leave_time, {0, kHour, "s"})},
         {"second_fault_time", number_into(&is->second_fault_time, {0, kHour, "s"})},
         {"mismatch_window", number_into(&is->mismatch_window, {0, kHour, "s"})},

@@ -126,28 +126,44 @@ TEST(BenchDrivers, AResidualAboveItsBarWhenDetectionGoesLiveIsNotRaised) {
       ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
     }
   }
-  // AND the status says so while it lasts: the gyro awaits its onset from the first live
-  // sample until its J_N falls (907.9 s); the accelerometer, below its bar, does not
-  FdiEngine engine(engine_cfg);
-  std::vector<FaultEvent> events;
-  double first = kNaN, last = kNaN;
-  bool accelerometer = false;
-  for (const Sample& s : data.samples) {
-    if (s.t > 960.0) break;
-    events.clear();
-    engine.process(s, &events);
-    const IsolatorStatus& st = engine.isolation_status();
-    if (st.awaiting_onset[1]) {
-      if (std::isnan(first)) first = s.t;
-      last = s.t;
+  // AND the status says why. The gyro's bar, learned on J_N that sat at the clip for the last
+  // 20 s of learning, had to be capped: the shipped configuration closes the channel
+  // (bar_unreachable from the first live sample). With capped bars left standing the gyro
+  // awaits its onset from the first live sample until its J_N falls (907.9 s). The
+  // accelerometer, below its bar, does neither.
+  for (const bool close : {true, false}) {
+    SCOPED_TRACE(close ? "capped bars close" : "capped bars stand");
+    EngineConfig cfg = engine_cfg;
+    cfg.isolation.close_capped_bars = close;
+    FdiEngine engine(cfg);
+    std::vector<FaultEvent> events;
+    double first = kNaN, last = kNaN, closed_from = kNaN;
+    bool accelerometer = false;
+    for (const Sample& s : data.samples) {
+      if (s.t > 960.0) break;
+      events.clear();
+      engine.process(s, &events);
+      const IsolatorStatus& st = engine.isolation_status();
+      if (st.awaiting_onset[1]) {
+        if (std::isnan(first)) first = s.t;
+        last = s.t;
+      }
+      if (st.bar_unreachable[1] && std::isnan(closed_from)) closed_from = s.t;
+      accelerometer = accelerometer || st.awaiting_onset[0];
     }
-    accelerometer = accelerometer || st.awaiting_onset[0];
+    EXPECT_FALSE(accelerometer);
+    if (close) {
+      EXPECT_TRUE(std::isnan(first)) << "awaiting its onset at " << first << " s";
+      ASSERT_TRUE(std::isfinite(closed_from));
+      EXPECT_NEAR(closed_from, r.t_armed, 0.5);
+      continue;
+    }
+    EXPECT_FALSE(closed_from < first + 1.0) << "closed at " << closed_from << " s";
+    ASSERT_TRUE(std::isfinite(first));
+    EXPECT_NEAR(first, r.t_armed, 0.5);
+    EXPECT_GT(last, 905.0);
+    EXPECT_LT(last, 909.0);
   }
-  ASSERT_TRUE(std::isfinite(first));
-  EXPECT_NEAR(first, r.t_armed, 0.5);
-  EXPECT_GT(last, 905.0);
-  EXPECT_LT(last, 909.0);
-  EXPECT_FALSE(accelerometer);
 }
 
 TEST(BenchDrivers, ABiasTheJumpCheckRaisedIsNotShownRectifiedBeforeHoldMax) {
@@ -225,9 +241,10 @@ TEST(BenchDrivers, TheFirstZigzagExecuteOfAFastHullIsNoGyroJump) {
 /// The engine with the shipped configuration (as the proving ground runs it) on the healthy
 /// first `until` seconds of a proving-ground run (one with a fault, which begins later).
 MethodResult replay_healthy_start(const std::string& table, const std::string& voyage,
-                                  std::uint64_t seed, double until) {
+                                  std::uint64_t seed, double until, bool close_capped_bars = true) {
   EngineConfig engine_cfg;
   const std::optional<Case> pick = proving_ground_run(table, voyage, seed, true, &engine_cfg);
+  engine_cfg.isolation.close_capped_bars = close_capped_bars;
   if (!pick) {
     ADD_FAILURE() << "the proving ground no longer has run " << seed;
     return {};
@@ -277,9 +294,10 @@ TEST(BenchDrivers, ACourseChangeJudgedTheModelsIsNotRaisedAgainAtTheNextOne) {
   // to stop 38 that raised the gyro 16 times from 245 to 764 s. Each raise, and each
   // model-mismatch verdict on such a rise, kept the peak out of the healthy maxima the bar
   // follows, so the next course change met the same bar.
-  // WHEN the engine with the shipped configuration replays it
-  const MethodResult r =
-      replay_healthy_start("otter3dof @ 50 Hz", "course/calm", 13365152606205054189ull, 900.0);
+  // WHEN the engine replays it with a capped bar left standing (close_capped_bars false: the
+  // shipped configuration closes this gyro channel, whose bar had to be capped, see below)
+  const MethodResult r = replay_healthy_start("otter3dof @ 50 Hz", "course/calm",
+                                              13365152606205054189ull, 900.0, false);
   // THEN once a rise has been judged the model's, the peaks it brought are part of the
   // healthy maxima and the course changes after it raise nothing
   ASSERT_FALSE(r.mismatches.empty());
@@ -292,6 +310,13 @@ TEST(BenchDrivers, ACourseChangeJudgedTheModelsIsNotRaisedAgainAtTheNextOne) {
   }
   EXPECT_EQ(after, 0) << "the first verdict at " << judged << " s";
   EXPECT_LE(raises, 5);
+  // AND with the shipped configuration the gyro channel, whose healthy J_N went to the clip
+  // while its first design learned, is closed: no course change raises it, none is judged
+  const MethodResult shipped =
+      replay_healthy_start("otter3dof @ 50 Hz", "course/calm", 13365152606205054189ull, 900.0);
+  expect_no_raise(shipped);
+  EXPECT_TRUE(shipped.mismatches.empty()) << "first verdict at " << shipped.mismatches.front().t;
+  ASSERT_TRUE(std::isfinite(shipped.t_armed));
 }
 
 }  // namespace

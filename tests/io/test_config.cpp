@@ -87,6 +87,8 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.enter_time, q.enter_time);
   EXPECT_EQ(p.young_enter_ratio, q.young_enter_ratio);
   EXPECT_EQ(p.onset_lookback, q.onset_lookback);
+  EXPECT_EQ(p.close_capped_bars, q.close_capped_bars);
+  EXPECT_EQ(p.relearn_after_raise, q.relearn_after_raise);
   EXPECT_EQ(p.leave_time, q.leave_time);
   EXPECT_EQ(p.second_fault_time, q.second_fault_time);
   EXPECT_EQ(p.mismatch_window, q.mismatch_window);
@@ -221,6 +223,8 @@ isolation:
   second_fault_time: 3.5
   young_enter_ratio: 1.25
   onset_lookback: 2.5
+  close_capped_bars: false
+  relearn_after_raise: false
   resume_after_fault: 4.5
 jump:
   enabled: false
@@ -269,6 +273,8 @@ service:
   EXPECT_EQ(c.isolation.second_fault_time, 3.5);
   EXPECT_EQ(c.isolation.young_enter_ratio, 1.25);
   EXPECT_EQ(c.isolation.onset_lookback, 2.5);
+  EXPECT_FALSE(c.isolation.close_capped_bars);
+  EXPECT_FALSE(c.isolation.relearn_after_raise);
   EXPECT_EQ(c.isolation.resume_after_fault, 4.5);
   EXPECT_FALSE(c.isolation.jump.enabled);
   EXPECT_EQ(c.isolation.jump.pre_window, 2.0);

@@ -103,8 +103,9 @@ int raises_after(const IsolationParams& p, double after) {
 TEST(IsolatorThresholds, AModelMismatchMetInHealthyManoeuvresRaisesTheBar) {
   // GIVEN the same course changes again and again, with a model that is off in each
   IsolationParams p;
-  p.jump.enabled = false;  // the observers alone
-  p.enter_time = 0.06;     // and no confirmation time: the thresholds alone
+  p.jump.enabled = false;       // the observers alone
+  p.enter_time = 0.06;          // and no confirmation time: the thresholds alone
+  p.close_capped_bars = false;  // and a bar capped within reach, not closed
   // WHEN the thresholds remember the healthy past (10 minutes) THEN after the first ten
   // minutes nothing is raised
   EXPECT_EQ(raises_after(p, 600.0), 0);
@@ -182,6 +183,51 @@ TEST(IsolatorThresholds, ABarTheStatisticCannotPassIsFlagged) {
   const Vec2 off = unreachable_share(0.8);
   EXPECT_GT(off(1), 0.9) << off.transpose();
   EXPECT_LT(off(0), 0.05) << off.transpose();
+}
+
+/// The gyro's bar and flag at the first live sample, and the gyro's raises, the isolation
+/// stage (the observers alone) given the Otter's A with a3, a4 20 % off on its course changes.
+struct FirstLive {
+  double bar = 0.0;
+  bool flagged = false;
+  int raises = 0;
+};
+FirstLive gyro_first_live(bool close_capped_bars) {
+  IsolationParams p;
+  p.jump.enabled = false;
+  p.close_capped_bars = close_capped_bars;
+  FirstLive f;
+  bool seen = false;
+  run_given_A(p, otter_A_yaw_scaled(0.8), otter_course_changes(600.0, 7),
+              [&](const SimRow&, const std::vector<Detection>& dets, const IsolatorStatus& st) {
+                for (const Detection& d : dets) {
+                  f.raises += d.sensor == Sensor::kGyro && d.active && !d.update;
+                }
+                if (seen || !st.armed || st.learning || st.settling || !(st.thresholds(1) > 0)) {
+                  return;
+                }
+                seen = true;
+                f.bar = st.thresholds(1);
+                f.flagged = st.bar_unreachable[1];
+              });
+  EXPECT_TRUE(seen);
+  return f;
+}
+
+TEST(IsolatorThresholds, ABarThatHadToBeCappedClosesTheChannelFromGoingLive) {
+  // GIVEN the Otter's course changes with a model 20 % off in a3 and a4: the gyro's J_N in
+  // learning already went where a fault would take it
+  const double c2 = IsolationParams{}.clip * IsolationParams{}.clip;
+  // WHEN the capped bar stands THEN the gyro goes live with a bar J_N can pass
+  const FirstLive capped = gyro_first_live(false);
+  EXPECT_LT(capped.bar, c2);
+  EXPECT_FALSE(capped.flagged);
+  // WHEN it closes the channel (the default) THEN the gyro goes live closed, flagged, and
+  // its residual raises nothing
+  const FirstLive closed = gyro_first_live(true);
+  EXPECT_GE(closed.bar, c2);
+  EXPECT_TRUE(closed.flagged);
+  EXPECT_EQ(closed.raises, 0);
 }
 
 TEST(IsolatorThresholds, TheHistoryBarNeverFallsAsTheHealthyMaximumRisesAndStaysReachable) {

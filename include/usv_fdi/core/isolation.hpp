@@ -78,6 +78,15 @@ struct IsolationParams {
   /// of the learning samples): a fault that began in the last seconds of learning (the
   /// paper's gyro bias, 0.9 s before) keeps its onset [s]
   double onset_lookback = 5.0;
+  /// A channel whose bar learned on J_N had to be capped at 0.75 clip^2 to stay within the
+  /// statistic's reach is closed instead (its bar above clip^2: IsolatorStatus::
+  /// bar_unreachable) until a new design learns again: its healthy J_N already went where a
+  /// fault would take it (docs/benchmark.md, "A bar that had to be capped closes the
+  /// channel"). false: the capped bar stands.
+  bool close_capped_bars = true;
+  /// A redesign still learning when a fault is raised starts its learning again (what it
+  /// learned just before the raise may hold the fault's onset). false: it keeps it.
+  bool relearn_after_raise = true;
   double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
@@ -430,8 +439,12 @@ class Isolator {
   FaultKind classify(int ch) const;
   std::size_t window_samples(double dt) const;
   double learned_threshold(std::vector<double>* healthy) const;
+  /// Forget a bank's learning: it learns its scales and bars again from the next healthy data.
+  void restart_learning(Bank* b);
   /// The highest threshold a windowed statistic of clipped squares reaches with margin.
   double reachable_threshold() const;
+  /// A closed bar, in clip^2 (close_capped_bars).
+  static constexpr double kClosedBar = 1.05;
   /// The bar the healthy past sets for a statistic whose healthy maximum is healthy_max.
   double history_threshold(double healthy_max) const;
 
@@ -453,6 +466,7 @@ class Isolator {
   double settle_time_ = 0.0;
   double t_last_suspect_ = -1e300;
   double t_last_fault_ = -1e300;
+  bool was_faulty_ = false;  ///< a fault condition was active at the last sample
   bool freeze_ = false;
   bool data_inconsistent_ = false;  ///< identification's guard keeps the latest data out
   bool scales_configured_ = false;
