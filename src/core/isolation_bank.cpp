@@ -108,12 +108,14 @@ void Isolator::restart_learning(Bank* b) {
   for (auto& v : b->learn_raw) std::vector<double>().swap(v);
   for (auto& v : b->learn_J) std::vector<double>().swap(v);
   for (auto& v : b->learn_D) std::vector<double>().swap(v);
+  // Its windows too: they hold samples from before the raise, whitened by the scales just
+  // forgotten, and would be the first of the next learning.
+  for (int c = 0; c < 2; ++c) {
+    for (auto* w : {&b->win_s[c], &b->win_sl[c], &b->win_d[c]}) *w = Window{};
+  }
 }
 
 double Isolator::reachable_threshold() const { return 0.75 * p_.clip * p_.clip; }
-
-// A closed bar: above clip^2, which a windowed mean of squares clipped at +-clip never passes.
-constexpr double Isolator::kClosedBar;
 
 double Isolator::learned_threshold(std::vector<double>* healthy) const {
   // The median, the MAD about it and the 99.9 % quantile (the value a sort would put at rank
@@ -280,7 +282,9 @@ bool Isolator::evaluate(Bank* b, const Sample& s, double dt, bool learn_ok, bool
         // going live; a Mariner at 50 Hz whose accelerometer J_N sat at the clip for 216 s).
         // Judged on the learning before the onset look-back: a fault that began in the last
         // seconds of learning (the paper's gyro bias) caps the bar too, and keeps its onset.
-        if (p_.close_capped_bars && b->threshold(c) >= reachable_threshold() && J.size() > back) {
+        // (A floor, threshold, at or above the cap would cap every bar: not the data's doing.)
+        if (p_.close_capped_bars && b->threshold(c) >= reachable_threshold() &&
+            p_.threshold < reachable_threshold() && J.size() > back) {
           std::vector<double> past(J.begin(), J.end() - static_cast<std::ptrdiff_t>(back));
           if (learned_threshold(&past) >= reachable_threshold()) {
             b->threshold(c) = kClosedBar * p_.clip * p_.clip;

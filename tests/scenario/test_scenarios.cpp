@@ -417,7 +417,7 @@ TEST(Relearning, ARedesignLearningThroughADriftsOnsetLearnsAgainAndKeepsItsChann
     // WHEN the raise restarts that learning (the shipped configuration), THEN the redesign
     // learns on healthy data after the fault and the accelerometer's channel stays open.
     // Kept, the learning holds the drift's first seconds: the learned bar had to be capped
-    // and the channel closes (at 825.7 s), blind to the accelerometer's stuck fault at 960 s.
+    // and the channel closes (at 825.7 s): its residual is blind to the faults after it.
     if (relearn) {
       EXPECT_TRUE(std::isnan(closed_from)) << "closed at " << closed_from << " s";
     } else {

@@ -82,7 +82,9 @@ struct IsolationParams {
   /// statistic's reach is closed instead (its bar above clip^2: IsolatorStatus::
   /// bar_unreachable) until a new design learns again: its healthy J_N already went where a
   /// fault would take it (docs/benchmark.md, "A bar that had to be capped closes the
-  /// channel"). false: the capped bar stands.
+  /// channel"). The new design's bar is still at least the history bar, which the closed
+  /// channel's healthy maxima may hold out of reach for up to `history`. Not applied when
+  /// `threshold` itself is at or above the cap. false: the capped bar stands.
   bool close_capped_bars = true;
   /// A redesign still learning when a fault is raised starts its learning again (what it
   /// learned just before the raise may hold the fault's onset). false: it keeps it.
@@ -205,7 +207,8 @@ struct IsolatorStatus {
   std::array<bool, 2> awaiting_onset{};
   /// Per channel: its bar on J_N is at or above clip^2, which the statistic (a mean of squares
   /// clipped at +-clip) can never pass: its residual raises nothing while this holds (the
-  /// healthy maximum reached the clip: waves, or a model that does not hold).
+  /// healthy maximum reached the clip: waves, or a model that does not hold; or the bar
+  /// learned at the design's learning had to be capped: IsolationParams::close_capped_bars).
   std::array<bool, 2> bar_unreachable{};
   InputHealth input;
   std::uint64_t samples = 0;
@@ -443,7 +446,8 @@ class Isolator {
   void restart_learning(Bank* b);
   /// The highest threshold a windowed statistic of clipped squares reaches with margin.
   double reachable_threshold() const;
-  /// A closed bar, in clip^2 (close_capped_bars).
+  /// A closed bar, in clip^2 (close_capped_bars): above clip^2, which a windowed mean of
+  /// squares clipped at +-clip never passes.
   static constexpr double kClosedBar = 1.05;
   /// The bar the healthy past sets for a statistic whose healthy maximum is healthy_max.
   double history_threshold(double healthy_max) const;
