@@ -122,7 +122,13 @@ TEST(BridgeEndToEnd, PaperScenarioAlertsFollowTheLifecycleAndAcnAcknowledges) {
   ASSERT_TRUE(f.process("bridge").wait_exit(seconds(10)).has_value());
   const std::string log = f.log("bridge");
   EXPECT_NE(log.find("1 checksum mismatch"), std::string::npos) << log;
-  EXPECT_NE(log.find("2 bad header"), std::string::npos) << log;
+  // Its own two bad headers at least: a datagram of another process on the loopback (a Fast
+  // DDS participant of a test running beside it, whose well-known RTPS port can be this
+  // run's ephemeral ACN port) is a bad header too, and counted.
+  const std::size_t bad = log.find(" bad header", log.find("not acted on:"));
+  ASSERT_NE(bad, std::string::npos) << log;
+  const std::size_t digits = log.find_last_not_of("0123456789", bad - 1) + 1;
+  EXPECT_GE(std::stoul(log.substr(digits, bad - digits)), 2u) << log;
   EXPECT_NE(log.find("bridge input: ACN "), std::string::npos) << "fields missing\n" << log;
   EXPECT_NE(log.find("2 acks sent, 2 ARC"), std::string::npos) << log;
 }
