@@ -110,9 +110,7 @@ void Isolator::restart_learning(Bank* b) {
   for (auto& v : b->learn_D) std::vector<double>().swap(v);
   // Its windows too: they hold samples from before the raise, whitened by the scales just
   // forgotten, and would be the first of the next learning.
-  for (int c = 0; c < 2; ++c) {
-    for (auto* w : {&b->win_s[c], &b->win_sl[c], &b->win_d[c]}) *w = Window{};
-  }
+  for (int c = 0; c < 2; ++c) b->clear_windows(c);
 }
 
 double Isolator::reachable_threshold() const { return 0.75 * p_.clip * p_.clip; }
@@ -340,7 +338,7 @@ void Isolator::resync_observers(const Sample& s, bool v_ok, bool r_ok) {
       Vec2 x = healthy.x();
       x(c) = y;
       o.reset(x);
-      for (auto* w : {&b->win_s[c], &b->win_sl[c], &b->win_d[c]}) *w = Window{};
+      b->clear_windows(c);
     }
     chan_[c].resync = false;
     chan_[c].resettle_until = s.t + settle_time_;

@@ -360,6 +360,10 @@ class Isolator {
     std::array<Window, 2> win_sl;  ///< signed structured residuals (classification)
     std::array<Window, 2> win_d;   ///< clipped squared cross residuals
     Vec2 J = Vec2::Zero(), D = Vec2::Zero();
+    /// Empties channel c's evaluation windows.
+    void clear_windows(int c) {
+      for (Window* w : {&win_s[c], &win_sl[c], &win_d[c]}) *w = Window{};
+    }
   };
 
   bool design(const Mat2& A, Bank* b);
