@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,11 @@ struct RunResult {
   Estimate final_estimate;
 };
 
-inline RunResult run(const SimConfig& sim, const EngineConfig& cfg) {
+/// Called after every sample the engine processed, with that sample and the engine.
+using EachSample = std::function<void(const SimRow&, const FdiEngine&)>;
+
+inline RunResult run(const SimConfig& sim, const EngineConfig& cfg,
+                     const EachSample& each = nullptr) {
   RunResult out;
   FdiEngine engine(cfg);
   Simulator simulator(sim);
@@ -42,6 +47,7 @@ inline RunResult run(const SimConfig& sim, const EngineConfig& cfg) {
       }
     }
     if (std::isnan(out.t_armed) && engine.isolation_status().armed) out.t_armed = row.t;
+    if (each) each(row, engine);
     if (row.t >= next_estimate) {
       out.estimates.push_back(engine.estimate());
       next_estimate += 1.0;

@@ -403,17 +403,13 @@ TEST(Relearning, ARedesignLearningThroughADriftsOnsetLearnsAgainAndKeepsItsChann
     SCOPED_TRACE(relearn ? "relearns after a raise" : "keeps its learning");
     EngineConfig cfg = vessel_config("mariner");
     cfg.isolation.relearn_after_raise = relearn;
-    FdiEngine engine(cfg);
-    Simulator simulator(sim);
-    SimRow row;
-    std::vector<FaultEvent> events;
     double closed_from = kNaN;
-    while (simulator.next(&row)) {
-      events.clear();
-      engine.process(Sample{row.t, row.v, row.r, row.delta}, &events);
-      const IsolatorStatus& st = engine.isolation_status();
-      if (row.t > 780.0 && st.bar_unreachable[0] && std::isnan(closed_from)) closed_from = row.t;
-    }
+    run(sim, cfg, [&](const SimRow& row, const FdiEngine& engine) {
+      if (row.t > 780.0 && engine.isolation_status().bar_unreachable[0] &&
+          std::isnan(closed_from)) {
+        closed_from = row.t;
+      }
+    });
     // WHEN the raise restarts that learning (the shipped configuration), THEN the redesign
     // learns on healthy data after the fault and the accelerometer's channel stays open.
     // Kept, the learning holds the drift's first seconds: the learned bar had to be capped
