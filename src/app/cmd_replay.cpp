@@ -196,9 +196,10 @@ int run_replay(const ReplayArgs& a) {
   if (code == kExitOk || code == kExitRejected) {
     spdlog::info(
         "{}: {} samples over {:.1f} s ({} rejected), {} events (raised: accelerometer {}, gyro "
-        "{}, unknown {}), estimate {}converged, {} samples frozen",
+        "{}, unknown {}), estimate {}converged (convergence lost {} times), {} samples frozen",
         a.input, sum.samples, sum.duration_s, sum.rejected, sum.events, sum.raised[0],
-        sum.raised[1], sum.raised[2], sum.converged ? "" : "not ", sum.frozen_samples);
+        sum.raised[1], sum.raised[2], sum.converged ? "" : "not ", sum.unconvergences,
+        sum.frozen_samples);
   }
   return code;
 }

@@ -47,6 +47,9 @@ void IdentificationParams::validate() const {
   require(guard_threshold > 0, "guard_threshold", guard_threshold, "must be positive");
   require(guard_min_shift >= 0, "guard_min_shift", guard_min_shift, "must not be negative");
   require(guard_recent_time > 0, "guard_recent_time", guard_recent_time, "must be positive");
+  require(uncertain_ratio == 0 || uncertain_ratio >= 1, "uncertain_ratio", uncertain_ratio,
+          "must be 0 (off) or at least 1");
+  require(uncertain_time >= 0, "uncertain_time", uncertain_time, "must not be negative");
 }
 
 const char* to_string(IdentStatus s) {
@@ -65,6 +68,8 @@ const char* to_string(IdentStatus s) {
       return "not converged: standard errors too large";
     case IdentStatus::kSettling:
       return "not converged: estimate settling";
+    case IdentStatus::kUncertain:
+      return "not converged: uncertainty grew after convergence";
   }
   return "?";
 }
@@ -467,13 +472,34 @@ void Identifier::update_convergence(double t) {
                        est_.time_constant <= p_.settle_window * p_.settle_windows;
   settled_count_ =
       (d < p_.settle_tolerance && precise && excited && consistent) ? settled_count_ + 1 : 0;
-  if (settled_count_ >= p_.settle_windows) est_.converged = true;
+  if (settled_count_ >= p_.settle_windows && !est_.converged) {
+    est_.converged = true;
+    lost_ = false;
+    t_uncertain_ = kNaN;
+  }
+  if (est_.converged && p_.method == IdentMethod::kKreisselmeier && p_.uncertain_ratio > 0) {
+    // A converged estimate the data no longer support (its uncertainty grew, the memory
+    // having forgotten what defined it) is not kept as converged: it may wander far.
+    const double limit =
+        p_.precision == Precision::kPrediction ? p_.max_prediction_error : p_.max_std_error;
+    if (!(est_.uncertainty <= p_.uncertain_ratio * limit)) {
+      if (std::isnan(t_uncertain_)) t_uncertain_ = t;
+      if (t - t_uncertain_ >= p_.uncertain_time) {
+        est_.converged = false;
+        lost_ = true;
+        settled_count_ = 0;
+        ++est_.unconvergences;
+      }
+    } else {
+      t_uncertain_ = kNaN;
+    }
+  }
   if (est_.converged) {
     est_.status = IdentStatus::kConverged;
   } else {
     est_.status = !consistent ? IdentStatus::kInconsistent
                   : !excited  ? IdentStatus::kLowExcitation
-                  : !precise  ? IdentStatus::kImprecise
+                  : !precise  ? (lost_ ? IdentStatus::kUncertain : IdentStatus::kImprecise)
                               : IdentStatus::kSettling;
   }
   t_ref_ = t;

@@ -148,6 +148,23 @@ void Isolator::set_estimate(const Estimate& est) {
     publish_bank();
     return;
   }
+  if (!est.converged && p_.on_lost_convergence == LostConvergence::kUnarm) {
+    // The data no longer support the estimate: the residual checks stop at the next sample
+    // (update has the detections' output), and arm again once it has converged anew.
+    unarm_pending_ = true;
+    return;
+  }
+  st_.design_held = p_.on_lost_convergence == LostConvergence::kHold && !est.converged;
+  if (st_.design_held) {
+    // The data no longer support the estimate: keep the design in force, and drop a
+    // redesign made on an estimate that was already losing its footing.
+    if (has_shadow_) {
+      shadow_ = Bank{};
+      has_shadow_ = false;
+      st_.relearning = false;
+    }
+    return;
+  }
   // One redesign learns at a time; the design in force keeps detecting meanwhile.
   if (has_shadow_) return;
   const double ref = act_.A.norm();
@@ -181,6 +198,7 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   if (have_prev_ && dt > p_.stale_timeout) ++st_.input.gaps;
   sensor_checks(s, out);
   jump_checks(s, out);
+  if (unarm_pending_) unarm(s.t, out);
   if (st_.armed) residual_checks(s, dt, out);
 
   // Freeze identification while anything is suspect, and for resume_time after.
@@ -209,6 +227,40 @@ bool Isolator::update(const Sample& s, std::vector<Detection>* out) {
   prev_ = s;
   have_prev_ = true;
   return true;
+}
+
+void Isolator::unarm(double t, std::vector<Detection>* out) {
+  unarm_pending_ = false;
+  if (!st_.armed) return;
+  const std::string why = "estimate of A lost convergence: residual checks off until it converges";
+  for (int k = 0; k < 3; ++k) {
+    // The residual path's own raises (its spike test included) end with it.
+    for (const Source src : {kResidual, kSpikes}) {
+      if (!(sens_[k].cond.sources & src)) continue;
+      set_condition(static_cast<Sensor>(k), src, false, sens_[k].cond.kind, t, why, out);
+    }
+    sens_[k].above_since = sens_[k].below_since = kNaN;
+  }
+  for (ChannelState& ch : chan_) {
+    // What the residual path kept of the channel goes; the jump check's own record stays.
+    ChannelState fresh;
+    fresh.jump_at = ch.jump_at;
+    fresh.jump_handed = ch.jump_handed;
+    ch = std::move(fresh);
+  }
+  act_ = Bank{};
+  shadow_ = Bank{};
+  has_shadow_ = false;
+  st_.armed = st_.learning = st_.settling = st_.relearning = false;
+  st_.model_mismatch = false;
+  st_.mismatch_reason.clear();
+  mismatch_since_ = below_mm_since_ = kNaN;
+  mismatch_repeated_ = repeat_rise_ = -1;
+  st_.awaiting_onset = {};
+  st_.bar_unreachable = {};
+  st_.J = st_.D = st_.M = Vec2::Zero();
+  reset_drift(t);
+  ++st_.unarms;
 }
 
 bool Isolator::reject_timestamp(std::vector<Detection>* out) {

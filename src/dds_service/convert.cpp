@@ -136,6 +136,9 @@ fdi::FdiStatus to_dds(const pipeline::PipelineStatus& s, std::uint32_t mmsi,
     msg += "armed, learning healthy statistics; ";
   } else {
     msg += "armed; ";
+    if (s.isolation.design_held) {
+      msg += "estimate of A lost convergence: observer design held; ";
+    }
     // (said, because the channel's residual path is closed until then)
     for (int c = 0; c < 2; ++c) {
       if (s.isolation.awaiting_onset[c]) {

@@ -146,7 +146,7 @@ void JsonlWriter::summary(const RunSummary& s) {
        << ",\"events\":" << s.events << ",\"raised\":{\"accelerometer\":" << s.raised[0]
        << ",\"gyro\":" << s.raised[1] << ",\"unknown\":" << s.raised[2]
        << "},\"final_a\":" << array4(s.final_a) << ",\"converged\":" << boolean(s.converged)
-       << ",\"frozen_samples\":" << s.frozen_samples
+       << ",\"frozen_samples\":" << s.frozen_samples << ",\"unconvergences\":" << s.unconvergences
        << ",\"duration_s\":" << json_number(s.duration_s)
        << ",\"complete\":" << boolean(s.complete);
   if (!s.complete) out_ << ",\"error\":" << json_string(s.error);

@@ -157,6 +157,15 @@ std::string convergence_report(const Estimate& est, const IdentificationParams& 
       }
     }
   }
+  if (est.status == IdentStatus::kUncertain) {
+    why.push_back(format("it had converged, and lost convergence %.0f time(s) since: its "
+                         "uncertainty stayed above identification.uncertain_ratio = %g times "
+                         "its limit for identification.uncertain_time = %g s",
+                         static_cast<double>(est.unconvergences), p.uncertain_ratio,
+                         p.uncertain_time) +
+                  " (the data no longer supported it; isolation.on_lost_convergence says what "
+                  "detection does meanwhile, by default it is off)");
+  }
   if (!est.consistent || est.inconsistent_time > 0.0) {
     why.push_back(
         format("the data contradicted the memory for the last %.3g s (consistency "

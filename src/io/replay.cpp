@@ -44,6 +44,7 @@ class Replay {
     sum_.final_a = to_params(engine_.estimate().A);
     sum_.converged = engine_.estimate().converged;
     sum_.frozen_samples = engine_.frozen_samples();
+    sum_.unconvergences = engine_.estimate().unconvergences;
     sum_.duration_s = std::isnan(first_t_) ? 0.0 : last_t_ - first_t_;
     sum_.warnings = plausible_.warnings();
     sum_.not_converged = convergence_report(engine_.estimate(), cfg_.identification);

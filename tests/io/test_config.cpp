@@ -53,6 +53,8 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(x.guard_threshold, y.guard_threshold);
   EXPECT_EQ(x.guard_min_shift, y.guard_min_shift);
   EXPECT_EQ(x.guard_recent_time, y.guard_recent_time);
+  EXPECT_EQ(x.uncertain_ratio, y.uncertain_ratio);
+  EXPECT_EQ(x.uncertain_time, y.uncertain_time);
   EXPECT_EQ(x.a0, y.a0);
   EXPECT_EQ(x.min_excitation, y.min_excitation);
   EXPECT_EQ(x.settle_window, y.settle_window);
@@ -89,6 +91,7 @@ void expect_same(const EngineConfig& a, const EngineConfig& b) {
   EXPECT_EQ(p.onset_lookback, q.onset_lookback);
   EXPECT_EQ(p.close_capped_bars, q.close_capped_bars);
   EXPECT_EQ(p.relearn_after_raise, q.relearn_after_raise);
+  EXPECT_EQ(p.on_lost_convergence, q.on_lost_convergence);
   EXPECT_EQ(p.leave_time, q.leave_time);
   EXPECT_EQ(p.second_fault_time, q.second_fault_time);
   EXPECT_EQ(p.mismatch_window, q.mismatch_window);
@@ -192,6 +195,8 @@ identification:
   max_std_error: 0.2
   precision: coefficients
   max_prediction_error: 0.03
+  uncertain_ratio: 4
+  uncertain_time: 20
   guard: false
   guard_threshold: 50
   guard_min_shift: 0.002
@@ -263,6 +268,8 @@ service:
   EXPECT_EQ(c.identification.max_std_error, 0.2);
   EXPECT_EQ(c.identification.precision, Precision::kCoefficients);
   EXPECT_EQ(c.identification.max_prediction_error, 0.03);
+  EXPECT_EQ(c.identification.uncertain_ratio, 4.0);
+  EXPECT_EQ(c.identification.uncertain_time, 20.0);
   EXPECT_EQ(c.isolation.stuck_probability, 1e-6);
   EXPECT_EQ(c.isolation.stuck_learn_time, 30.0);
   EXPECT_EQ(c.isolation.stuck_time_max, 4.0);

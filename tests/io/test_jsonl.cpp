@@ -78,6 +78,7 @@ TEST(Jsonl, RecordsAreOneObjectPerLineWithTheirFields) {
   s.final_a = Vec4(-1, -2, -3, -4);
   s.converged = true;
   s.frozen_samples = 7;
+  s.unconvergences = 2;
   s.duration_s = 99.0;
   w.summary(s);
   s.complete = false;
@@ -123,6 +124,7 @@ TEST(Jsonl, RecordsAreOneObjectPerLineWithTheirFields) {
   EXPECT_EQ(su.at("raised").at("accelerometer").num, 0.0);
   EXPECT_EQ(su.at("final_a").arr.size(), 4u);
   EXPECT_EQ(su.at("frozen_samples").num, 7.0);
+  EXPECT_EQ(su.at("unconvergences").num, 2.0);
   EXPECT_EQ(su.at("duration_s").num, 99.0);
   EXPECT_TRUE(su.at("complete").b);
   EXPECT_FALSE(su.has("error"));

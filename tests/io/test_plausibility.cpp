@@ -119,6 +119,17 @@ TEST(Plausibility, ConvergenceReportSaysWhy) {
   short_run.resize(80);
   const std::string early = convergence_report(run(short_run), cfg.identification);
   EXPECT_TRUE(has(early, "warmup_time")) << early;
+
+  // A converged estimate whose uncertainty grew (Identifier's own test makes one).
+  Estimate lost = good;
+  lost.converged = false;
+  lost.status = IdentStatus::kUncertain;
+  lost.unconvergences = 2;
+  lost.uncertainty = 0.3;
+  const std::string grew = convergence_report(lost, cfg.identification);
+  EXPECT_TRUE(has(grew, "uncertainty grew after convergence")) << grew;
+  EXPECT_TRUE(has(grew, "lost convergence 2 time(s)")) << grew;
+  EXPECT_TRUE(has(grew, "identification.uncertain_ratio")) << grew;
 }
 
 TEST(Plausibility, ReplaySummaryCarriesTheFindings) {

@@ -92,6 +92,7 @@ TEST(Replay, CsvReplayGivesTheEventsOfTheInMemoryRun) {
   EXPECT_EQ(sum.events, want.size());
   EXPECT_EQ(to_params(engine.estimate().A), sum.final_a);
   EXPECT_EQ(engine.frozen_samples(), sum.frozen_samples);
+  EXPECT_EQ(engine.estimate().unconvergences, sum.unconvergences);
 }
 
 TEST(Replay, SummaryCountsRaisesNotRefinements) {

@@ -142,5 +142,80 @@ TEST(InputPrefilterInEngine, TheNoisyMarinerArmsWithinAMinuteWithItAndAfterTwoWi
   EXPECT_TRUE(std::isnan(without) || without > 120.0) << without;
 }
 
+// An estimate that lost convergence (its uncertainty grew: IdentificationParams::
+// uncertain_ratio) may wander far. The isolation stage un-arms (the default) or keeps the
+// design in force instead of following it, and arms again, or follows again, once the
+// estimate has converged anew.
+TEST(IsolatorDesign, AnEstimateThatLostConvergenceUnarmsOrHoldsUntilItConvergesAgain) {
+  for (const LostConvergence mode :
+       {LostConvergence::kUnarm, LostConvergence::kHold, LostConvergence::kFollow}) {
+    SCOPED_TRACE(static_cast<int>(mode));
+    SimConfig sim;
+    sim.vessel = otter();
+    sim.rate_hz = 10.0;
+    sim.duration = 400.0;
+    // A gyro drift from 100 s to 200 s, raised from the residuals before the estimate is lost
+    sim.faults.push_back(FaultInjection{Sensor::kGyro, FaultKind::kDrift, 100.0, 200.0, 0.001});
+    IsolationParams p;
+    p.on_lost_convergence = mode;
+    Isolator iso(p, sim.vessel.B);
+    Estimate est;
+    est.A = sim.vessel.A;
+    est.warming_up = false;
+    Mat2 wandered = sim.vessel.A;
+    wandered(0, 1) *= 1.2;  // beyond redesign_tolerance
+    std::vector<Detection> dets;
+    bool armed_while_lost = false, relearning_while_lost = false, held = false;
+    bool raised = false, cleared_while_lost = false;
+    std::string clear_message;
+    for (const SimRow& r : simulate(sim)) {
+      dets.clear();
+      iso.update({r.t, r.v, r.r, r.delta}, &dets);
+      const bool lost = r.t >= 140.0 && r.t < 250.0;
+      for (const Detection& d : dets) {
+        if (d.sensor != Sensor::kGyro) continue;
+        raised = raised || d.active;
+        if (!d.active && lost && !cleared_while_lost) {
+          cleared_while_lost = true;
+          clear_message = d.message;  // the first clear while lost
+        }
+      }
+      // GIVEN an isolator armed on A at 1 s, the gyro's drift raised before 140 s
+      // WHEN the estimate has wandered and lost convergence from 140 s to 250 s,
+      //   and has converged again on the wandered A from 250 s on
+      est.t = r.t;
+      if (r.t >= 140.0) est.A = wandered;
+      est.converged = !lost;
+      est.status = est.converged ? IdentStatus::kConverged : IdentStatus::kUncertain;
+      if (r.t >= 1.0) iso.set_estimate(est);
+      const IsolatorStatus& st = iso.status();
+      if (lost && r.t >= 141.0) {
+        armed_while_lost = armed_while_lost || st.armed;
+        relearning_while_lost = relearning_while_lost || st.relearning;
+        held = held || st.design_held;
+      }
+      if (r.t >= 250.0) {
+        EXPECT_FALSE(st.design_held) << r.t;
+      }
+    }
+    const IsolatorStatus& st = iso.status();
+    ASSERT_TRUE(raised);
+    // THEN un-armed: detection is off while the estimate is lost, the raised fault clears
+    //   saying why, and it arms again on the new estimate
+    // AND held: the design in force stays, nothing is redesigned, the status says so
+    // AND followed: the wandered A is redesigned at once
+    EXPECT_EQ(armed_while_lost, mode != LostConvergence::kUnarm);
+    EXPECT_EQ(held, mode == LostConvergence::kHold);
+    EXPECT_EQ(relearning_while_lost, mode == LostConvergence::kFollow);
+    EXPECT_EQ(st.unarms, mode == LostConvergence::kUnarm ? 1u : 0u);
+    if (mode == LostConvergence::kUnarm) {
+      EXPECT_TRUE(cleared_while_lost);
+      EXPECT_NE(clear_message.find("lost convergence"), std::string::npos) << clear_message;
+    }
+    EXPECT_TRUE(st.armed);
+    EXPECT_EQ(st.A_design, wandered);
+  }
+}
+
 }  // namespace
 }  // namespace usvfdi

@@ -582,6 +582,71 @@ TEST(StandardError, IsCalibratedOnNoisyData) {
   }
 }
 
+// A converged estimate is sticky no longer: when the memory forgets the manoeuvres that
+// defined it, the standard errors grow, and the estimate (free to wander on data that cannot
+// tell) is reported as such instead of "converged".
+TEST(Convergence, IsLostWhenTheDataNoLongerSupportTheEstimate) {
+  Mat2 A;
+  A << -0.883024, -0.438614, -1.55172, -1.16124;
+  const Vec2 B(0.165394, -2.19400);
+  // GIVEN the Otter steered by rudder sines for 400 s, then held on course by a faint rudder
+  //   (0.003 rad) in a seaway (white process noise on v' and r'), for 2000 s
+  std::vector<Sample> data;
+  std::mt19937_64 rng(77);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const double h = 0.1, q = 0.004;
+  Vec2 x = Vec2::Zero();
+  const auto rudder = [](double t) {
+    return t < 400.0 ? 0.1 * std::sin(0.31 * t + 0.3) + 0.07 * std::sin(0.77 * t + 1.9)
+                     : 0.003 * std::sin(0.5 * t);
+  };
+  for (int k = 0; k <= 24000; ++k) {
+    const double t = k * h;
+    data.push_back(Sample{t, x(0) + 0.01 * n01(rng), x(1) + 0.0005 * n01(rng), rudder(t)});
+    const int sub = 10;
+    for (int j = 0; j < sub; ++j) {  // RK4 under the rudder, then the seaway's kick
+      const double ts = t + j * h / sub, hs = h / sub;
+      const auto f = [&](double tt, const Vec2& y) -> Vec2 { return A * y + B * rudder(tt); };
+      const Vec2 k1 = f(ts, x), k2 = f(ts + hs / 2, x + hs / 2 * k1);
+      const Vec2 k3 = f(ts + hs / 2, x + hs / 2 * k2), k4 = f(ts + hs, x + hs * k3);
+      x += hs / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      x += q * std::sqrt(hs) * Vec2(n01(rng), 0.1 * n01(rng));
+    }
+  }
+  for (const double ratio : {5.0, 0.0}) {
+    IdentificationParams p;
+    p.uncertain_ratio = ratio;
+    Identifier id(p, B);
+    double t_converged = kNaN, t_lost = kNaN;
+    for (const Sample& smp : data) {
+      ASSERT_TRUE(id.update(smp, false));
+      const Estimate& e = id.estimate();
+      if (std::isnan(t_converged) && e.converged) t_converged = smp.t;
+      if (std::isnan(t_lost) && !std::isnan(t_converged) && !e.converged) t_lost = smp.t;
+    }
+    const Estimate& e = id.estimate();
+    std::cout << "[ INFO     ] uncertain_ratio " << ratio << ": converged at " << t_converged
+              << " s, lost at " << t_lost << " s, uncertainty at the end " << e.uncertainty
+              << ", status " << to_string(e.status) << ", error of A^ "
+              << (e.A - A).norm() / A.norm() << "\n";
+    // THEN it converges on the manoeuvres
+    ASSERT_LT(t_converged, 400.0);
+    if (ratio > 0) {
+      // AND loses convergence in the straight run, once, saying why
+      EXPECT_GT(t_lost, 400.0);
+      EXPECT_FALSE(e.converged);
+      EXPECT_EQ(e.status, IdentStatus::kUncertain);
+      EXPECT_EQ(e.unconvergences, 1u);
+      EXPECT_GT(e.uncertainty, ratio * p.max_prediction_error);
+    } else {
+      // AND without the rule it stays "converged" on the same data
+      EXPECT_TRUE(std::isnan(t_lost));
+      EXPECT_TRUE(e.converged);
+      EXPECT_EQ(e.unconvergences, 0u);
+    }
+  }
+}
+
 // Identifier::update once compared s.t with the last *unfrozen* sample, so after a freeze a
 // sample older than the last frozen one was accepted and estimate().t went back.
 TEST(Identifier, TimeMustIncreaseAcrossFrozenSamplesToo) {
@@ -625,6 +690,9 @@ TEST(IdentificationParams, ValidateNamesTheOffendingField) {
   p = IdentificationParams{};
   p.min_excitation = 1.5;
   EXPECT_NE(message(p).find("min_excitation"), std::string::npos);
+  p = IdentificationParams{};
+  p.uncertain_ratio = 0.5;
+  EXPECT_NE(message(p).find("uncertain_ratio"), std::string::npos);
   EXPECT_THROW(Identifier(IdentificationParams{}, Vec2(kNaN, 1.0)), std::invalid_argument);
 }
 

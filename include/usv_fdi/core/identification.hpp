@@ -125,6 +125,14 @@ struct IdentificationParams {
   /// against coefficients' 512, sooner, and the engine then meets the model mismatch of
   /// manoeuvres and waves: 0.53 false alarms per healthy hour against 0.44 (docs/benchmark.md).
   Precision precision = Precision::kPrediction;
+  /// A converged estimate whose uncertainty (Estimate::uncertainty) stays above this multiple
+  /// of its limit (max_prediction_error or max_std_error) for uncertain_time is no longer
+  /// converged (IdentStatus::kUncertain, Estimate::unconvergences): the data no longer support
+  /// it (the memory forgot the manoeuvres that defined it), and the estimate may wander far
+  /// while the status would say converged. It converges again by the ordinary criterion.
+  /// 0: converged stays converged (the engine before 2026-12-07). Kreisselmeier only.
+  double uncertain_ratio = 5.0;
+  double uncertain_time = 10.0;  ///< [s], see uncertain_ratio
   // Consistency guard (Kreisselmeier only; see the header comment).
   bool guard = true;  ///< judge every window of data before it enters the memory
   /// A window is inconsistent when its equation-error statistic (chi-square with 4 degrees
@@ -154,6 +162,9 @@ enum class IdentStatus : std::uint8_t {
   kLowExcitation,  ///< the rudder has not excited v and r independently enough yet
   kImprecise,      ///< standard errors still above max_std_error
   kSettling,       ///< the estimate still moves
+  /// It had converged, and its uncertainty grew past uncertain_ratio x its limit: the data
+  /// no longer support it.
+  kUncertain,
 };
 /// "not converged: equation error inconsistent", ... ("converged" for kConverged).
 const char* to_string(IdentStatus s);
@@ -165,7 +176,11 @@ struct Estimate {
   /// With a speed input: s = u / U0 of the last sample, and U0 [m/s] (1 and NaN without).
   double speed_ratio = 1.0;
   double reference_speed = kNaN;
-  bool converged = false;    ///< sticky once the criterion held
+  /// The criterion held, and the uncertainty has not since grown past uncertain_ratio x its
+  /// limit (IdentificationParams::uncertain_ratio).
+  bool converged = false;
+  /// How often a converged estimate lost convergence because its uncertainty grew.
+  std::uint64_t unconvergences = 0;
   double excitation = 0.0;   ///< normalised excitation of the extended regressor, [0,1]
   double psi = 0.0;          ///< mixed regressor psi
   double time_constant = 0;  ///< current time constant of the scalar laws [s] (inf: none)
@@ -328,6 +343,10 @@ class Identifier {
   Vec4 a_ref_;
   double t_ref_ = kNaN;
   int settled_count_ = 0;
+  double t_uncertain_ = kNaN;  ///< since when a converged estimate's uncertainty is too high
+  /// Whether the estimate lost convergence (kUncertain instead of kImprecise until it
+  /// converges again).
+  bool lost_ = false;
   Estimate est_;
 };
 

@@ -29,6 +29,18 @@
 
 namespace usvfdi {
 
+/// IsolationParams::on_lost_convergence.
+enum class LostConvergence : std::uint8_t {
+  /// Un-arm: the residual checks stop (their raised conditions clear, saying why) and arm
+  /// again, with a new design and its learning, when the estimate has converged anew.
+  kUnarm = 0,
+  /// Keep the design in force and redesign nothing until the estimate converges again
+  /// (IsolatorStatus::design_held).
+  kHold,
+  /// Redesigns follow the estimate, converged or not (the engine before 2026-12-07).
+  kFollow,
+};
+
 struct IsolationParams {
   Vec2 poles_v = Vec2(-0.5, -0.7);    ///< poles of observer V [1/s]
   Vec2 poles_g = Vec2(-0.5, -0.7);    ///< poles of observer G [1/s]
@@ -89,6 +101,9 @@ struct IsolationParams {
   /// A redesign still learning when a fault is raised starts its learning again (what it
   /// learned just before the raise may hold the fault's onset). false: it keeps it.
   bool relearn_after_raise = true;
+  /// What the isolation thread does when A's estimate loses convergence after arming
+  /// (IdentificationParams::uncertain_ratio: its uncertainty grew; it may wander far).
+  LostConvergence on_lost_convergence = LostConvergence::kUnarm;
   double leave_time = 1.0;  ///< below the leave threshold this long clears [s]
   /// While one sensor's fault is raised, the other raises after J_N stayed above its
   /// threshold this long. Its structured entry is blind to the first fault, but the design
@@ -178,6 +193,12 @@ struct IsolatorStatus {
   bool relearning = false;    ///< a redesign is learning its statistics beside the design in force
   std::uint64_t designs = 0;  ///< observer designs put in force (the first at arming)
   std::string observer_problem;  ///< why an observer design was refused (empty when fine)
+  /// A's estimate lost convergence after arming: the design in force is kept, no redesign
+  /// until it converges again (LostConvergence::kHold).
+  bool design_held = false;
+  /// Times the residual checks were un-armed because A's estimate lost convergence
+  /// (LostConvergence::kUnarm).
+  std::uint64_t unarms = 0;
   Mat2 A_design = Mat2::Zero();
   Vec2 k_v = Vec2::Zero(), k_g = Vec2::Zero();
   Vec2 sigma_s = Vec2::Zero();  ///< scales of the structured residual [m/s, rad/s]
@@ -446,6 +467,10 @@ class Isolator {
   FaultKind classify(int ch) const;
   std::size_t window_samples(double dt) const;
   double learned_threshold(std::vector<double>* healthy) const;
+  /// Un-arms the residual checks (LostConvergence::kUnarm): their conditions clear, the banks
+  /// and the channels' residual state are dropped; set_estimate arms again.
+  void unarm(double t, std::vector<Detection>* out);
+  bool unarm_pending_ = false;
   /// Forget a bank's learning: it learns its scales and bars again from the next healthy data.
   void restart_learning(Bank* b);
   /// The highest threshold a windowed statistic of clipped squares reaches with margin.

@@ -6,7 +6,7 @@
 //    "c_a":..,"c_g":..}   (replay --signals S only)
 //   {"type":"summary","samples":n,"rejected":n,"events":n,
 //    "raised":{"accelerometer":n,"gyro":n,"unknown":n},"final_a":[..],"converged":bool,
-//    "frozen_samples":n,"duration_s":..,"complete":bool[,"error":".."]}
+//    "frozen_samples":n,"unconvergences":n,"duration_s":..,"complete":bool[,"error":".."]}
 //
 // Numbers are written with %.9g; NaN and infinities as null. Hand-written (no JSON library).
 #pragma once
@@ -61,8 +61,9 @@ struct RunSummary {
   Vec4 final_a = Vec4::Zero();
   bool converged = false;
   std::uint64_t frozen_samples = 0;
-  double duration_s = 0.0;  ///< last minus first sample time [s, data time]
-  bool complete = true;     ///< false: the input ended in an error
+  std::uint64_t unconvergences = 0;  ///< times a converged estimate lost convergence
+  double duration_s = 0.0;           ///< last minus first sample time [s, data time]
+  bool complete = true;              ///< false: the input ended in an error
   // For the command's messages, not in the JSON record:
   std::vector<std::string> warnings;  ///< PlausibilityCheck's findings on the input
   std::string not_converged;          ///< convergence_report() at the end ("" if converged)
