@@ -149,6 +149,9 @@ void Identifier::refresh_aux_model(double t) {
 }
 
 void Identifier::restart_filters(const Sample& s) {
+  // A grown uncertainty must last uncertain_time of evaluated data: a freeze and the warm-up
+  // after it change nothing in the memory, and do not count.
+  t_uncertain_ = kNaN;
   // Zero initial conditions, as in the paper; the warm-up hides the e^{-eps t} transient.
   q_.setZero();
   m_.setZero();

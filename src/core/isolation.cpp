@@ -148,11 +148,11 @@ void Isolator::set_estimate(const Estimate& est) {
     publish_bank();
     return;
   }
-  if (!est.converged && p_.on_lost_convergence == LostConvergence::kUnarm) {
+  if (p_.on_lost_convergence == LostConvergence::kUnarm) {
     // The data no longer support the estimate: the residual checks stop at the next sample
     // (update has the detections' output), and arm again once it has converged anew.
-    unarm_pending_ = true;
-    return;
+    unarm_pending_ = !est.converged;
+    if (unarm_pending_) return;
   }
   st_.design_held = p_.on_lost_convergence == LostConvergence::kHold && !est.converged;
   if (st_.design_held) {
@@ -240,17 +240,25 @@ void Isolator::unarm(double t, std::vector<Detection>* out) {
       set_condition(static_cast<Sensor>(k), src, false, sens_[k].cond.kind, t, why, out);
     }
     sens_[k].above_since = sens_[k].below_since = kNaN;
+    sens_[k].raised_at = sens_[k].unheld_at = kNaN;
   }
   for (ChannelState& ch : chan_) {
-    // What the residual path kept of the channel goes; the jump check's own record stays.
+    // What the residual path kept of the channel goes; the jump check's time of its raise
+    // stays (a raised jump is no longer handed to observers that are gone: a new design
+    // takes it over).
     ChannelState fresh;
     fresh.jump_at = ch.jump_at;
-    fresh.jump_handed = ch.jump_handed;
     ch = std::move(fresh);
   }
   act_ = Bank{};
   shadow_ = Bank{};
   has_shadow_ = false;
+  // The healthy maxima were learned on a design the data no longer support: a new one starts
+  // without them, as the first did.
+  healthy_.clear();
+  pending_stats_.clear();
+  drift_healthy_.clear();
+  pending_drift_.clear();
   st_.armed = st_.learning = st_.settling = st_.relearning = false;
   st_.model_mismatch = false;
   st_.mismatch_reason.clear();
@@ -258,8 +266,11 @@ void Isolator::unarm(double t, std::vector<Detection>* out) {
   mismatch_repeated_ = repeat_rise_ = -1;
   st_.awaiting_onset = {};
   st_.bar_unreachable = {};
-  st_.J = st_.D = st_.M = Vec2::Zero();
+  st_.J = st_.D = st_.M = st_.s = st_.d = Vec2::Zero();
+  st_.c_a = st_.c_g = 0.0;
   reset_drift(t);
+  st_.drift_S = st_.drift_threshold = Vec2::Zero();
+  publish_bank();  // the design's figures go with it (A_design, scales and bars read 0)
   ++st_.unarms;
 }
 

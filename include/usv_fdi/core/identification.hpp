@@ -132,7 +132,8 @@ struct IdentificationParams {
   /// while the status would say converged. It converges again by the ordinary criterion.
   /// 0: converged stays converged (the engine before 2026-12-07). Kreisselmeier only.
   double uncertain_ratio = 5.0;
-  double uncertain_time = 10.0;  ///< [s], see uncertain_ratio
+  /// [s], see uncertain_ratio; of evaluated data (a freeze and the warm-up after it restart it)
+  double uncertain_time = 10.0;
   // Consistency guard (Kreisselmeier only; see the header comment).
   bool guard = true;  ///< judge every window of data before it enters the memory
   /// A window is inconsistent when its equation-error statistic (chi-square with 4 degrees

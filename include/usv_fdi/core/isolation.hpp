@@ -31,8 +31,9 @@ namespace usvfdi {
 
 /// IsolationParams::on_lost_convergence.
 enum class LostConvergence : std::uint8_t {
-  /// Un-arm: the residual checks stop (their raised conditions clear, saying why) and arm
-  /// again, with a new design and its learning, when the estimate has converged anew.
+  /// Un-arm: the residual checks stop (their raised conditions clear, saying why), the banks
+  /// and the healthy maxima are dropped, and they arm again, with a new design and its
+  /// learning, when the estimate has converged anew.
   kUnarm = 0,
   /// Keep the design in force and redesign nothing until the estimate converges again
   /// (IsolatorStatus::design_held).
