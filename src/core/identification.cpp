@@ -477,7 +477,6 @@ void Identifier::update_convergence(double t) {
       (d < p_.settle_tolerance && precise && excited && consistent) ? settled_count_ + 1 : 0;
   if (settled_count_ >= p_.settle_windows && !est_.converged) {
     est_.converged = true;
-    lost_ = false;
     t_uncertain_ = kNaN;
   }
   if (est_.converged && p_.method == IdentMethod::kKreisselmeier && p_.uncertain_ratio > 0) {
@@ -489,7 +488,6 @@ void Identifier::update_convergence(double t) {
       if (std::isnan(t_uncertain_)) t_uncertain_ = t;
       if (t - t_uncertain_ >= p_.uncertain_time) {
         est_.converged = false;
-        lost_ = true;
         settled_count_ = 0;
         ++est_.unconvergences;
       }
@@ -500,10 +498,13 @@ void Identifier::update_convergence(double t) {
   if (est_.converged) {
     est_.status = IdentStatus::kConverged;
   } else {
-    est_.status = !consistent ? IdentStatus::kInconsistent
-                  : !excited  ? IdentStatus::kLowExcitation
-                  : !precise  ? (lost_ ? IdentStatus::kUncertain : IdentStatus::kImprecise)
-                              : IdentStatus::kSettling;
+    // Imprecise after a loss of convergence reads uncertain (only a loss ends convergence, so
+    // an estimate not converged that has lost it before has not found it again).
+    est_.status =
+        !consistent ? IdentStatus::kInconsistent
+        : !excited  ? IdentStatus::kLowExcitation
+        : !precise  ? (est_.unconvergences > 0 ? IdentStatus::kUncertain : IdentStatus::kImprecise)
+                    : IdentStatus::kSettling;
   }
   t_ref_ = t;
   a_ref_ = a_;

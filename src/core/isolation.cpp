@@ -158,11 +158,7 @@ void Isolator::set_estimate(const Estimate& est) {
   if (st_.design_held) {
     // The data no longer support the estimate: keep the design in force, and drop a
     // redesign made on an estimate that was already losing its footing.
-    if (has_shadow_) {
-      shadow_ = Bank{};
-      has_shadow_ = false;
-      st_.relearning = false;
-    }
+    drop_shadow();
     return;
   }
   // One redesign learns at a time; the design in force keeps detecting meanwhile.
@@ -251,27 +247,31 @@ void Isolator::unarm(double t, std::vector<Detection>* out) {
     ch = std::move(fresh);
   }
   act_ = Bank{};
-  shadow_ = Bank{};
-  has_shadow_ = false;
+  drop_shadow();
   // The healthy maxima were learned on a design the data no longer support: a new one starts
   // without them, as the first did.
   healthy_.clear();
   pending_stats_.clear();
   drift_healthy_.clear();
   pending_drift_.clear();
-  st_.armed = st_.learning = st_.settling = st_.relearning = false;
+  st_.armed = st_.learning = st_.settling = false;
   st_.model_mismatch = false;
   st_.mismatch_reason.clear();
   mismatch_since_ = below_mm_since_ = kNaN;
   mismatch_repeated_ = repeat_rise_ = -1;
   st_.awaiting_onset = {};
-  st_.bar_unreachable = {};
   st_.J = st_.D = st_.M = st_.s = st_.d = Vec2::Zero();
   st_.c_a = st_.c_g = 0.0;
   reset_drift(t);
   st_.drift_S = st_.drift_threshold = Vec2::Zero();
-  publish_bank();  // the design's figures go with it (A_design, scales and bars read 0)
+  publish_bank();  // the design's figures go with it (A_design, scales, bars, relearning)
   ++st_.unarms;
+}
+
+void Isolator::drop_shadow() {
+  shadow_ = Bank{};
+  has_shadow_ = false;
+  st_.relearning = false;
 }
 
 bool Isolator::reject_timestamp(std::vector<Detection>* out) {

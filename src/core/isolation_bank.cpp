@@ -365,8 +365,7 @@ bool Isolator::evaluate_banks(const Sample& s, double dt, bool learn_ok, bool v_
       swapped = true;  // this sample is already in its windows
       // The redesign has learned its own statistics: it takes over.
       act_ = std::move(shadow_);
-      shadow_ = Bank{};
-      has_shadow_ = false;
+      drop_shadow();
       // The healthy maxima carry over: the new design whitens its residuals with scales of
       // its own, so its statistics are comparable, and a manoeuvre met under the old one is
       // no less likely to come again.

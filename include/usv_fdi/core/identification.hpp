@@ -345,9 +345,6 @@ class Identifier {
   double t_ref_ = kNaN;
   int settled_count_ = 0;
   double t_uncertain_ = kNaN;  ///< since when a converged estimate's uncertainty is too high
-  /// Whether the estimate lost convergence (kUncertain instead of kImprecise until it
-  /// converges again).
-  bool lost_ = false;
   Estimate est_;
 };
 

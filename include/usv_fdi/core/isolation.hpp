@@ -471,6 +471,8 @@ class Isolator {
   /// Un-arms the residual checks (LostConvergence::kUnarm): their conditions clear, the banks
   /// and the channels' residual state are dropped; set_estimate arms again.
   void unarm(double t, std::vector<Detection>* out);
+  /// Drops the redesign learning beside the design in force, if any.
+  void drop_shadow();
   bool unarm_pending_ = false;
   /// Forget a bank's learning: it learns its scales and bars again from the next healthy data.
   void restart_learning(Bank* b);
