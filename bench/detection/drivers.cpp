@@ -27,18 +27,25 @@ class AlarmTracker {
 };
 
 /// Detection is live: armed, settled and learned. The flags are those of the last update, so
-/// the sample on which set_estimate arms (after its update) does not count yet.
+/// the sample on which set_estimate arms (after its update) does not count yet. Each span of
+/// live samples is recorded: the engine un-arms when its estimate loses convergence.
 class ArmingClock {
  public:
-  void after_sample(double t, const IsolatorStatus& st, double* t_armed) {
-    if (std::isnan(*t_armed) && armed_before_ && st.armed && !st.learning && !st.settling) {
-      *t_armed = t;
+  void after_sample(double t, const IsolatorStatus& st, MethodResult* r) {
+    const bool live = armed_before_ && st.armed && !st.learning && !st.settling;
+    if (live && !live_) {
+      r->live.push_back(LiveSpan{t});
+      if (std::isnan(r->t_armed)) r->t_armed = t;
+    } else if (!live && live_) {
+      r->live.back().to = t;
     }
+    live_ = live;
     armed_before_ = st.armed;
   }
 
  private:
   bool armed_before_ = false;
+  bool live_ = false;
 };
 
 /// Each new model-mismatch verdict of the isolation stage, with its reason.
@@ -74,12 +81,13 @@ MethodResult run_engine(const EngineConfig& cfg, const std::vector<Sample>& samp
         }
       }
     }
-    clock.after_sample(s.t, engine.isolation_status(), &r.t_armed);
+    clock.after_sample(s.t, engine.isolation_status(), &r);
     verdicts.after_sample(s.t, engine.isolation_status(), &r.mismatches);
     ++r.samples;
     if (engine.estimate().frozen) ++r.frozen_samples;
   }
   r.has_identification = true;
+  r.unarms = engine.isolation_status().unarms;
   r.A_final = engine.estimate().A;
   r.converged = engine.estimate().converged;
   return r;
@@ -122,7 +130,7 @@ MethodResult run_oracle(const IsolationParams& params, const Vec2& B, const Mat2
       iso.set_estimate(est);
       given = true;
     }
-    clock.after_sample(s.t, iso.status(), &r.t_armed);
+    clock.after_sample(s.t, iso.status(), &r);
     verdicts.after_sample(s.t, iso.status(), &r.mismatches);
     ++r.samples;
   }

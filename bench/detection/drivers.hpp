@@ -4,6 +4,7 @@
 // condition changes that scoring.hpp judges.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,12 @@ struct MethodResult {
   std::vector<MismatchVerdict> mismatches;  ///< in time order
   /// First sample at which detection was live (armed, settled, learned); NaN: never.
   double t_armed = kNaN;
+  /// Every span during which detection was live, the first from t_armed (the engine un-arms
+  /// when its estimate loses convergence, and arms again).
+  std::vector<LiveSpan> live;
+  /// Times the engine un-armed detection because its estimate lost convergence
+  /// (IsolatorStatus::unarms at the end; 0 for the oracle).
+  std::uint64_t unarms = 0;
   Mat2 A_final = Mat2::Zero();
   bool converged = false;  ///< the estimate said so at the end
   /// Samples of the run, and those on which identification was frozen (the estimate said so;

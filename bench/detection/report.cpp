@@ -93,8 +93,12 @@ void write_table(std::ostream& o, const TableSummary& t) {
 /// One method's result on the run of case c, as a JSON object.
 void write_method_result(std::ostream& o, const Case& c, const MethodResult& m) {
   const double ref = c.A_ref.norm();
-  o << "{\"t_armed\": " << json_num(m.t_armed)
-    << ", \"converged\": " << (m.converged ? "true" : "false")
+  o << "{\"t_armed\": " << json_num(m.t_armed) << ", \"live\": [";
+  for (std::size_t j = 0; j < m.live.size(); ++j) {
+    o << (j ? ", " : "") << "[" << json_num(m.live[j].from) << ", " << json_num(m.live[j].to)
+      << "]";
+  }
+  o << "], \"unarms\": " << m.unarms << ", \"converged\": " << (m.converged ? "true" : "false")
     << ", \"a_error\": " << json_num(ref > 0 ? (m.A_final - c.A_ref).norm() / ref : kNaN)
     << ", \"A_final\": [" << json_num(m.A_final(0, 0)) << ", " << json_num(m.A_final(0, 1)) << ", "
     << json_num(m.A_final(1, 0)) << ", " << json_num(m.A_final(1, 1)) << "]"

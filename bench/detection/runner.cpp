@@ -538,7 +538,7 @@ CaseResult run_case(const Case& c, std::size_t index, const EngineConfig& engine
   out.m[kPaper] = run_engine(pc, st.samples);
   out.m[kOracle] = run_oracle(engine_cfg.isolation, c.B, c.A_ref, st.samples);
   for (MethodResult& m : out.m) {
-    m.score = score_run(st.faults, m.alarms, out.t_first, out.t_last, m.t_armed, score);
+    m.score = score_run(st.faults, m.alarms, out.t_first, out.t_last, m.live, score);
   }
   return out;
 }
@@ -602,7 +602,7 @@ void add_method_run(const Case& c, const CaseResult& r, const MethodResult& mr, 
   a->a_error.push_back(ref > 0 ? (mr.A_final - c.A_ref).norm() / ref : kNaN);
   m->false_alarms += static_cast<int>(mr.score.false_alarms());
   for (double tf : mr.score.false_alarm_times) {
-    if (std::isfinite(mr.t_armed) && tf >= mr.t_armed) ++m->false_alarms_armed;
+    if (live_at(mr.live, tf)) ++m->false_alarms_armed;
   }
   m->healthy_hours += mr.score.healthy_time / 3600.0;
   m->healthy_armed_hours += mr.score.healthy_armed_time / 3600.0;

@@ -139,7 +139,7 @@ struct MethodSummary {
   double arming_median = kNaN, arming_max = kNaN;    ///< over the runs that armed [s]
   double a_error_median = kNaN, a_error_p95 = kNaN;  ///< ||A^ - A||_F / ||A||_F at the end
   std::vector<std::array<int, 3>> per_kind;  ///< faults, detected, isolated per standard kind
-  int false_alarms_armed = 0;                ///< those raised after arming
+  int false_alarms_armed = 0;                ///< those raised while detection was live
   /// The runs without a fault: their hours, the model-mismatch verdicts given on them, and
   /// the share of their samples on which identification was frozen (NaN: no identification).
   double healthy_run_hours = 0.0;

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace usvfdi::bench {
 
@@ -66,19 +68,38 @@ class DetectionWindows {
   std::vector<double> end_;
 };
 
-/// The run's span and its healthy time (outside the windows), in all and after arming.
+/// The run's span and its healthy time (outside the windows), in all and while live.
 void set_healthy_time(const std::vector<InjectedFault>& faults, const DetectionWindows& windows,
-                      double t_first, double t_last, double t_armed, RunScore* out) {
+                      double t_first, double t_last, const std::vector<LiveSpan>& live,
+                      RunScore* out) {
   out->span = t_last - t_first;
-  double in_windows = 0.0, in_windows_armed = 0.0;
-  const bool armed = std::isfinite(t_armed);
-  const double arm_from = armed ? std::max(t_armed, t_first) : t_last;
+  double in_windows = 0.0;
   for (std::size_t i = 0; i < faults.size(); ++i) {
     in_windows += overlap(faults[i].t_start, windows.end(i), t_first, t_last);
-    in_windows_armed += overlap(faults[i].t_start, windows.end(i), arm_from, t_last);
   }
   out->healthy_time = out->span - in_windows;
-  out->healthy_armed_time = armed ? (t_last - arm_from) - in_windows_armed : 0.0;
+  double live_healthy = 0.0;
+  for (const LiveSpan& l : live) {
+    const double from = std::max(l.from, t_first), to = std::min(l.to, t_last);
+    if (!(to > from)) continue;
+    live_healthy += to - from;
+    for (std::size_t i = 0; i < faults.size(); ++i) {
+      live_healthy -= overlap(faults[i].t_start, windows.end(i), from, to);
+    }
+  }
+  out->healthy_armed_time = live_healthy;
+}
+
+void check_live(const std::vector<LiveSpan>& live) {
+  for (std::size_t k = 0; k < live.size(); ++k) {
+    if (!(live[k].to > live[k].from)) {
+      throw std::invalid_argument("live span " + std::to_string(k) + " is empty");
+    }
+    if (k > 0 && live[k].from < live[k - 1].to) {
+      throw std::invalid_argument("live span " + std::to_string(k) +
+                                  " starts before the one before it ends");
+    }
+  }
 }
 
 /// Each raise within the run: the first in a fault's window detects it (delay, isolation);
@@ -158,21 +179,34 @@ void score_shown(const std::vector<Alarm>& alarms, FaultScore* fs) {
 
 }  // namespace
 
+bool live_at(const std::vector<LiveSpan>& live, double t) {
+  return std::any_of(live.begin(), live.end(),
+                     [t](const LiveSpan& l) { return l.from <= t && t < l.to; });
+}
+
 RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
                    double t_first, double t_last, double t_armed, const ScoreParams& params) {
+  std::vector<LiveSpan> live;
+  if (std::isfinite(t_armed)) live.push_back(LiveSpan{t_armed});
+  return score_run(std::move(faults), alarms, t_first, t_last, live, params);
+}
+
+RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
+                   double t_first, double t_last, const std::vector<LiveSpan>& live,
+                   const ScoreParams& params) {
   std::sort(faults.begin(), faults.end(),
             [](const InjectedFault& a, const InjectedFault& b) { return a.t_start < b.t_start; });
   check_run(faults, alarms, t_first, t_last);
+  check_live(live);
   const DetectionWindows windows(faults, params.detect_grace);
 
   RunScore out;
-  set_healthy_time(faults, windows, t_first, t_last, t_armed, &out);
+  set_healthy_time(faults, windows, t_first, t_last, live, &out);
   const std::size_t n = faults.size();
   out.faults.resize(n);
-  const bool armed = std::isfinite(t_armed);
   for (std::size_t i = 0; i < n; ++i) {
     out.faults[i].fault = faults[i];
-    out.faults[i].armed_at_onset = armed && t_armed <= faults[i].t_start;
+    out.faults[i].armed_at_onset = live_at(live, faults[i].t_start);
   }
   score_raises(alarms, windows, t_first, t_last, &out);
   for (std::size_t i = 0; i < n; ++i) {

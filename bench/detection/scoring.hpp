@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,7 @@ struct FaultScore {
   double delay = kNaN;           ///< first raise - onset [s]
   bool recovered = false;        ///< every condition cleared after the end (detected only)
   double recovery_delay = kNaN;  ///< [s]
-  bool armed_at_onset = false;   ///< filled by the caller (the detector's arming time)
+  bool armed_at_onset = false;   ///< detection was live at the onset (a live span holds it)
   /// Raised on the faulty sensor from its first raise in the fault to the fault's end, never
   /// cleared in between (a fault shown rectified while it lasts is, for the operator, gone).
   bool held = false;
@@ -68,13 +69,29 @@ struct RunScore {
   std::vector<double> false_alarm_durations;
   double span = 0.0;                ///< t_last - t_first [s]
   double healthy_time = 0.0;        ///< span minus detection windows [s]
-  double healthy_armed_time = 0.0;  ///< the part of it after arming [s]
+  double healthy_armed_time = 0.0;  ///< the part of it while detection was live [s]
   std::size_t false_alarms() const { return false_alarm_times.size(); }
 };
 
+/// A span during which a detector's detection was live (armed, settled, learned): [from, to).
+/// A detector may un-arm (the engine does when its estimate loses convergence) and arm again,
+/// so a run has zero or more, in time order and not overlapping; to = +inf: to the run's end.
+struct LiveSpan {
+  double from = 0.0;                                    ///< [s]
+  double to = std::numeric_limits<double>::infinity();  ///< exclusive [s]
+};
+
+/// Whether t lies in one of the spans.
+bool live_at(const std::vector<LiveSpan>& live, double t);
+
 /// Scores one run on [t_first, t_last]. Faults must not overlap (sorted or not); alarms must
-/// be in time order. t_armed: the detector's arming time (NaN: never armed). Throws
-/// std::invalid_argument on overlapping faults, t_end <= t_start or unordered alarms.
+/// be in time order; live: when detection was live (sorted, not overlapping). Throws
+/// std::invalid_argument on overlapping faults, t_end <= t_start, unordered alarms or live
+/// spans that are empty, unordered or overlapping.
+RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
+                   double t_first, double t_last, const std::vector<LiveSpan>& live,
+                   const ScoreParams& params = {});
+/// The same for a detector live from t_armed to the end (NaN: never live).
 RunScore score_run(std::vector<InjectedFault> faults, const std::vector<Alarm>& alarms,
                    double t_first, double t_last, double t_armed, const ScoreParams& params = {});
 

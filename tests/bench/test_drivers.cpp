@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <iostream>
 #include <optional>
 #include <string>
 
@@ -103,6 +104,47 @@ void expect_no_raise(const MethodResult& r) {
   for (const Alarm& a : r.alarms) {
     if (a.raised) ADD_FAILURE() << "raised " << to_string(a.sensor) << " at " << a.t << " s";
   }
+}
+
+// Issue 11, item 7, end to end: an estimate that loses convergence un-arms detection, which
+// arms again once the estimate converges again, and then finds the fault; the benchmark
+// scores only the live spans as armed.
+TEST(BenchDrivers, TheEngineUnarmsWhenItsEstimateLosesConvergenceAndArmsAgain) {
+  // GIVEN a proving-ground run (the Mariner, 50 Hz, calm course changes) whose estimate
+  // converges, loses convergence and converges again before the injected fault (a gyro bias
+  // from 1121 s; at stop 49 live 307-623 s and from 952 s)
+  EngineConfig engine_cfg;
+  const std::optional<Case> pick = proving_ground_run("mariner @ 50 Hz", "course/calm",
+                                                      10203985545584359410ull, true, &engine_cfg);
+  ASSERT_TRUE(pick) << "the proving ground no longer has this run";
+  const Stream data = pick->make();
+  const MethodResult r = run_engine(engine_cfg, data.samples);
+  for (const LiveSpan& l : r.live) {
+    std::cout << "[ INFO     ] live from " << l.from << " s to " << l.to << " s\n";
+  }
+  std::cout << "[ INFO     ] " << to_string(pick->fault.sensor) << " "
+            << to_string(pick->fault.kind) << " from " << pick->fault.t_start << " s\n";
+  // THEN detection was live, went off (an un-arm) and came back before the fault
+  ASSERT_GE(r.live.size(), 2u);
+  EXPECT_GE(r.unarms, 1u);
+  EXPECT_EQ(r.t_armed, r.live.front().from);
+  EXPECT_LT(r.live.front().to, r.live[1].from);
+  EXPECT_FALSE(live_at(r.live, (r.live.front().to + r.live[1].from) / 2));
+  EXPECT_LT(r.live.back().from, pick->fault.t_start);
+  EXPECT_TRUE(std::isinf(r.live.back().to));
+  // AND the fault is found on its sensor at once, nothing else is raised, and the score
+  // counts it armed at its onset
+  const RunScore score =
+      score_run(data.faults, r.alarms, data.samples.front().t, data.samples.back().t, r.live);
+  ASSERT_EQ(score.faults.size(), 1u);
+  EXPECT_TRUE(score.faults[0].armed_at_onset);
+  EXPECT_TRUE(score.faults[0].detected);
+  EXPECT_TRUE(score.faults[0].isolated);
+  EXPECT_LT(score.faults[0].delay, 2.0);
+  EXPECT_EQ(score.false_alarms(), 0u);
+  // AND the healthy time counted as armed leaves out the span it was off
+  EXPECT_LT(score.healthy_armed_time,
+            data.samples.back().t - r.t_armed - (r.live[1].from - r.live.front().to) + 1e-6);
 }
 
 TEST(BenchDrivers, AResidualAboveItsBarWhenDetectionGoesLiveIsNotRaised) {

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "scoring.hpp"
 
@@ -163,12 +164,44 @@ TEST(BenchScoring, ArmingAfterTheOnsetIsRecordedAndWindowsAreCutAtTheNextOnset) 
   EXPECT_NEAR(r.healthy_armed_time, (400 - 150) - 50 - 62, 1e-9);
 }
 
+TEST(BenchScoring, OnlyTheLiveSpansCountAsArmed) {
+  // Live from 50 s, un-armed at 120 s (the estimate lost convergence), live again from 200 s.
+  const std::vector<LiveSpan> live{{50, 120}, {200}};
+  EXPECT_FALSE(live_at(live, 49.9));
+  EXPECT_TRUE(live_at(live, 50));
+  EXPECT_FALSE(live_at(live, 120));
+  EXPECT_FALSE(live_at(live, 150));
+  EXPECT_TRUE(live_at(live, 1e9));
+  // Faults at 100 (live), 150 (un-armed) and 250 (live again).
+  const RunScore r = score_run({{kG, FaultKind::kBias, 100, 110},
+                                {kA, FaultKind::kBias, 150, 160},
+                                {kG, FaultKind::kBias, 250, 260}},
+                               {raise(100.4, kG), clear(111, kG)}, 0, 400, live);
+  ASSERT_EQ(r.faults.size(), 3u);
+  EXPECT_TRUE(r.faults[0].armed_at_onset);
+  EXPECT_FALSE(r.faults[1].armed_at_onset);
+  EXPECT_TRUE(r.faults[2].armed_at_onset);
+  // Healthy: 400 s minus three windows of 12 s; while live: [50, 120) and [200, 400) minus
+  // the windows in them ([100, 112) and [250, 262)).
+  EXPECT_NEAR(r.healthy_time, 400 - 36, 1e-9);
+  EXPECT_NEAR(r.healthy_armed_time, (70 - 12) + (200 - 12), 1e-9);
+  // A detector live from 50 s to the end is the same as one armed at 50 s.
+  const RunScore once = score_run({{kG, FaultKind::kBias, 150, 160}}, {}, 0, 400, 50);
+  const RunScore span =
+      score_run({{kG, FaultKind::kBias, 150, 160}}, {}, 0, 400, std::vector<LiveSpan>{{50}});
+  EXPECT_EQ(once.faults[0].armed_at_onset, span.faults[0].armed_at_onset);
+  EXPECT_NEAR(once.healthy_armed_time, span.healthy_armed_time, 1e-12);
+}
+
 TEST(BenchScoring, BadInputIsRefusedWithAReason) {
   EXPECT_THROW(score_run({{kG, FaultKind::kBias, 100, 100}}, {}, 0, 300, 0), std::invalid_argument);
   EXPECT_THROW(score_run({{kG, FaultKind::kBias, 100, 160}, {kA, FaultKind::kBias, 150, 200}}, {},
                          0, 300, 0),
                std::invalid_argument);
   EXPECT_THROW(score_run({}, {raise(5, kG), raise(4, kG)}, 0, 300, 0), std::invalid_argument);
+  EXPECT_THROW(score_run({}, {}, 0, 300, std::vector<LiveSpan>{{50, 50}}), std::invalid_argument);
+  EXPECT_THROW(score_run({}, {}, 0, 300, std::vector<LiveSpan>{{50, 120}, {100, 200}}),
+               std::invalid_argument);
   try {
     score_run({{kG, FaultKind::kBias, 100, 160}, {kA, FaultKind::kBias, 150, 200}}, {}, 0, 300, 0);
   } catch (const std::invalid_argument& e) {
