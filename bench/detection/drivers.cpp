@@ -33,19 +33,18 @@ class ArmingClock {
  public:
   void after_sample(double t, const IsolatorStatus& st, MethodResult* r) {
     const bool live = armed_before_ && st.armed && !st.learning && !st.settling;
-    if (live && !live_) {
+    const bool was_live = !r->live.empty() && std::isinf(r->live.back().to);
+    if (live && !was_live) {
       r->live.push_back(LiveSpan{t});
       if (std::isnan(r->t_armed)) r->t_armed = t;
-    } else if (!live && live_) {
+    } else if (!live && was_live) {
       r->live.back().to = t;
     }
-    live_ = live;
     armed_before_ = st.armed;
   }
 
  private:
   bool armed_before_ = false;
-  bool live_ = false;
 };
 
 /// Each new model-mismatch verdict of the isolation stage, with its reason.
